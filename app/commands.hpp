@@ -1,0 +1,11 @@
+#pragma once
+// Each sub-command registers itself on the CLI11 app and stores its exit code in `result` when it
+// runs. Errors are thrown (InputError -> exit 2, SimulationError -> exit 3) and mapped in main.cpp.
+#include <CLI/CLI.hpp>
+
+namespace cellsph::app {
+
+void register_neighbors(CLI::App& app, int& result);
+void register_bench(CLI::App& app, int& result);
+
+}  // namespace cellsph::app

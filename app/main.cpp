@@ -1,0 +1,34 @@
+// cellsph: the command-line program. Sub-commands live one per file in app/.
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cellsph/core/error.hpp"
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"cellsph: particle fluids (SPH) on the fastest exact neighbour search", "cellsph"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "cellsph 0.1.0");
+  int result = 0;
+  cellsph::app::register_neighbors(app, result);
+  cellsph::app::register_bench(app, result);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const cellsph::InputError& e) {
+    std::cerr << "cellsph: error: " << e.what() << "\n";
+    return 2;
+  } catch (const cellsph::SimulationError& e) {
+    std::cerr << "cellsph: simulation stopped: " << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "cellsph: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return result;
+}

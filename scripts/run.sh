@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Installs what is needed, builds cellsph (release) and runs the main job.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build/release -j "$(nproc)" >/dev/null
+exec build/release/cellsph "${@:-bench}" 

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages cellsph needs to build, test and benchmark. Idempotent.
+set -euo pipefail
+PKGS=(g++ cmake ninja-build git pkg-config
+      nlohmann-json3-dev libcli11-dev libnanoflann-dev libstb-dev libpng-dev
+      libgtest-dev libgmock-dev libbenchmark-dev)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "setup: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+fi

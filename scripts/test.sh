@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs what is needed, builds cellsph twice (release, and ASan+UBSan) and runs every test in both.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+JOBS=${JOBS:-$(nproc)}
+
+echo "== release build =="
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build/release -j "$JOBS"
+ctest --test-dir build/release -j "$JOBS" --output-on-failure
+
+echo "== ASan + UBSan build =="
+cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLSPH_SANITIZE=ON \
+  -DCELLSPH_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build/asan -j "$JOBS"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build/asan -j "$JOBS" --output-on-failure
