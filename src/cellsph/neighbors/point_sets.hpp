@@ -1,0 +1,67 @@
+#pragma once
+// Point sets shared by tests, benchmarks and `cellsph bench neighbors`. Deterministic for a seed.
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "cellsph/core/vec.hpp"
+
+namespace cellsph::point_sets {
+
+// Jittered lattice of n points (rounded down to a full block), spacing s, jitter +-jitter*s on
+// every axis. The block is as close to a cube (square in 2D) as possible.
+template <int Dim, class Real>
+std::vector<Vec<Dim, Real>> jittered_lattice(std::size_t n, Real s, Real jitter, std::uint64_t seed = 1) {
+  const auto side = static_cast<std::size_t>(std::floor(std::pow(double(n), 1.0 / Dim) + 1e-9));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec<Dim, Real>> x;
+  std::size_t total = 1;
+  for (int k = 0; k < Dim; ++k) total *= side;
+  x.reserve(total);
+  for (std::size_t idx = 0; idx < total; ++idx) {
+    std::size_t r = idx;
+    Vec<Dim, Real> p;
+    for (int k = 0; k < Dim; ++k) {
+      const std::size_t c = r % side;
+      r /= side;
+      p[k] = static_cast<Real>((double(c) + jitter * u(rng)) * double(s));
+    }
+    x.push_back(p);
+  }
+  return x;
+}
+
+// n points uniformly random in a box with the density of a lattice of spacing s.
+template <int Dim, class Real>
+std::vector<Vec<Dim, Real>> uniform_random(std::size_t n, Real s, std::uint64_t seed = 2) {
+  const double side = std::pow(double(n), 1.0 / Dim) * double(s);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, side);
+  std::vector<Vec<Dim, Real>> x(n);
+  for (auto& p : x)
+    for (int k = 0; k < Dim; ++k) p[k] = static_cast<Real>(u(rng));
+  return x;
+}
+
+// n points in Gaussian blobs inside the box of uniform_random: `blobs` centres, each blob's
+// standard deviation a tenth of the box side. Density varies by orders of magnitude.
+template <int Dim, class Real>
+std::vector<Vec<Dim, Real>> clustered(std::size_t n, Real s, int blobs = 8, std::uint64_t seed = 3) {
+  const double side = std::pow(double(n), 1.0 / Dim) * double(s);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.2 * side, 0.8 * side);
+  std::normal_distribution<double> g(0.0, 0.1 * side);
+  std::vector<Vec<Dim, double>> centres(static_cast<std::size_t>(blobs));
+  for (auto& c : centres)
+    for (int k = 0; k < Dim; ++k) c[k] = u(rng);
+  std::vector<Vec<Dim, Real>> x(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& c = centres[i % centres.size()];
+    for (int k = 0; k < Dim; ++k) x[i][k] = static_cast<Real>(c[k] + g(rng));
+  }
+  return x;
+}
+
+}  // namespace cellsph::point_sets

@@ -1,0 +1,56 @@
+#pragma once
+// Struct-of-arrays particle storage. The one list of fields is for_each_field(): outputs,
+// checkpoints and reordering are generated from it, so a new field is added in two places only
+// (the member and its line in the list).
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "cellsph/core/vec.hpp"
+
+namespace cellsph {
+
+template <int Dim, class Real>
+struct Particles {
+  using V = Vec<Dim, Real>;
+
+  std::vector<V> x;        // position [m]
+  std::vector<V> v;        // velocity [m/s]
+  std::vector<V> f;        // total force of the last evaluation [N]
+  std::vector<Real> m;     // mass [kg]
+  std::vector<Real> rho;   // density [kg/m^3]
+  std::vector<Real> p;     // pressure [Pa]
+  std::vector<Real> h;     // support length [m]
+  std::vector<Real> color; // interface colour value c_int (paper eq. 8c)
+  std::vector<Real> mu;    // dynamic viscosity [Pa s]
+  std::vector<std::int32_t> phase;  // phase index into the scene's phase table
+  std::vector<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
+
+  // The field list. f(name, vector) for every field, in a fixed order.
+  template <class Self, class F>
+  static void for_each_field(Self& self, F&& fn) {
+    fn(std::string_view("position"), self.x);
+    fn(std::string_view("velocity"), self.v);
+    fn(std::string_view("force"), self.f);
+    fn(std::string_view("mass"), self.m);
+    fn(std::string_view("density"), self.rho);
+    fn(std::string_view("pressure"), self.p);
+    fn(std::string_view("support"), self.h);
+    fn(std::string_view("color"), self.color);
+    fn(std::string_view("viscosity"), self.mu);
+    fn(std::string_view("phase"), self.phase);
+    fn(std::string_view("level"), self.level);
+  }
+  template <class F>
+  void for_each_field(F&& fn) { for_each_field(*this, fn); }
+  template <class F>
+  void for_each_field(F&& fn) const { for_each_field(*this, fn); }
+
+  [[nodiscard]] std::size_t size() const { return x.size(); }
+  void resize(std::size_t n) {
+    for_each_field([n](std::string_view, auto& field) { field.resize(n); });
+  }
+};
+
+}  // namespace cellsph
