@@ -1,0 +1,15 @@
+#pragma once
+// The built-in scenes: the JSON files of scenes/, compiled in by CMake.
+#include <string_view>
+#include <vector>
+
+namespace cellsph {
+
+struct BuiltinScene {
+  std::string_view name;  // file name without .json
+  std::string_view json;  // the file's text
+};
+
+const std::vector<BuiltinScene>& builtin_scenes();
+
+}  // namespace cellsph
