@@ -11,6 +11,10 @@
 
 namespace cellsph {
 
+// Boundary particles carry in `m` their Akinci weight psi_b = rho0 V_b (their contribution to a fluid
+// density), are never integrated and only interact with fluid particles.
+enum class ParticleKind : std::uint8_t { Fluid = 0, Boundary = 1 };
+
 template <int Dim, class Real>
 struct Particles {
   using V = Vec<Dim, Real>;
@@ -26,6 +30,7 @@ struct Particles {
   std::vector<Real> mu;    // dynamic viscosity [Pa s]
   std::vector<std::int32_t> phase;  // phase index into the scene's phase table
   std::vector<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
+  std::vector<std::uint8_t> kind;   // ParticleKind: fluid (integrated) or boundary (static, Akinci 2012)
 
   // The field list. f(name, vector) for every field, in a fixed order.
   template <class Self, class F>
@@ -41,6 +46,7 @@ struct Particles {
     fn(std::string_view("viscosity"), self.mu);
     fn(std::string_view("phase"), self.phase);
     fn(std::string_view("level"), self.level);
+    fn(std::string_view("kind"), self.kind);
   }
   template <class F>
   void for_each_field(F&& fn) { for_each_field(*this, fn); }

@@ -1,0 +1,106 @@
+#pragma once
+// Each SPH interaction written once, as a small inline function of a small struct of inputs, so that a
+// CPU loop (solver/) and a device kernel can both call it. Convention: x_ij = x_i - x_j, v_ij = v_i - v_j,
+// and every function returns the contribution of neighbour j to particle i.
+#include <cmath>
+
+#include "cellsph/core/hd.hpp"
+#include "cellsph/core/vec.hpp"
+
+namespace cellsph {
+
+// What a pair interaction needs to know about i and j.
+template <int Dim, class Real>
+struct PairInput {
+  Vec<Dim, Real> xij;  // x_i - x_j
+  Vec<Dim, Real> vij;  // v_i - v_j
+  Real r;              // |x_ij|
+  Real mi, mj;         // masses
+  Real rhoi, rhoj;     // densities
+  Real pi, pj;         // pressures
+  Real mui, muj;       // dynamic viscosities
+};
+
+// ---- Density -----------------------------------------------------------------------------------
+
+// Paper eq. 7 / write-up mass density: rho_i = sum_j m_j W(r_ij) (the self term j = i included by the caller).
+template <class Real, class Kernel>
+CELLSPH_HD inline Real density_term(const Kernel& w, Real mj, Real r2) {
+  return mj * w.W2(r2);
+}
+
+// ---- The paper's averaged forces (eq. 8a, 8b) --------------------------------------------------
+
+// eq. 8a: -V_i V_j (P_i + P_j)/2 grad W^press. Antisymmetric in i and j, so momentum is conserved.
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> averaged_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
+  const Real vi = in.mi / in.rhoi, vj = in.mj / in.rhoj;
+  return w.gradW(in.xij) * (-vi * vj * (in.pi + in.pj) / 2);
+}
+
+// eq. 8b: V_i V_j (mu_i + mu_j)/2 (v_j - v_i) lap W^visco. Symmetric weight, antisymmetric velocity.
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> averaged_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w) {
+  const Real vi = in.mi / in.rhoi, vj = in.mj / in.rhoj;
+  return in.vij * (-vi * vj * (in.mui + in.muj) / 2 * w.laplacian(in.r));
+}
+
+// ---- Colour field and interface tension (eq. 8c, 9; Mueller 2003 surface tension) ----------------
+
+template <int Dim, class Real>
+struct ColorField {
+  Vec<Dim, Real> grad{};  // grad C_i
+  Real lap = 0;           // lap C_i
+};
+
+// Algorithm 1, lines 11-12: grad C_i += V_j c_j grad W^poly, lap C_i += V_j c_j lap W^poly.
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline void accumulate_color(ColorField<Dim, Real>& c, const Vec<Dim, Real>& xij, Real r, Real vj,
+                                        Real cj, const Kernel& w) {
+  c.grad += w.gradW(xij) * (vj * cj);
+  c.lap += vj * cj * w.laplacian(r);
+}
+
+// eq. 9: f = -sigma lap C grad C / |grad C|, applied only where |grad C| exceeds the threshold: inside
+// a phase grad C is numerical noise and its direction meaningless (Mueller 2003's threshold l).
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> interface_tension_force(const ColorField<Dim, Real>& c, Real sigma,
+                                                         Real threshold) {
+  const Real g2 = norm2(c.grad);
+  if (g2 <= threshold * threshold || g2 <= Real(0)) return Vec<Dim, Real>{};
+  return c.grad * (-sigma * c.lap / std::sqrt(g2));
+}
+
+// ---- The write-up's WCSPH forces ---------------------------------------------------------------
+
+// Symmetric pressure force: -m_i m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij (momentum conserving).
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
+  const Real a = in.pi / (in.rhoi * in.rhoi) + in.pj / (in.rhoj * in.rhoj);
+  return w.gradW(in.xij) * (-in.mi * in.mj * a);
+}
+
+// Monaghan's viscosity operator (SPH derivative combined with a finite difference, Koschier et al. 2020):
+//   lap v_i = 2(d+2) sum_j V_j (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2) grad W_ij,
+// the 0.01 h^2 keeping the quotient finite as r -> 0. Written as a force with V_i V_j and the mean dynamic
+// viscosity, so that f_ij = -f_ji exactly.
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> monaghan_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w,
+                                                          Real h) {
+  const Real vi = in.mi / in.rhoi, vj = in.mj / in.rhoj;
+  const Real q = dot(in.vij, in.xij) / (in.r * in.r + Real(0.01) * h * h);
+  return w.gradW(in.xij) * (Real(2 * (Dim + 2)) * (in.mui + in.muj) / 2 * vi * vj * q);
+}
+
+// ---- Boundary particles (Akinci et al. 2012) ----------------------------------------------------
+
+// A boundary particle b of "volume mass" psi_b = rho0 V_b (V_b = 1 / sum_k W_bk over boundary particles)
+// adds psi_b W_ib to a fluid density, and pushes with the fluid particle's own pressure mirrored:
+//   f_i = -m_i psi_b (p_i / rho_i^2) grad W_ib.
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> boundary_pressure_force(const Vec<Dim, Real>& xib, Real mi, Real rhoi, Real pi,
+                                                         Real psib, const Kernel& w) {
+  return w.gradW(xib) * (-mi * psib * pi / (rhoi * rhoi));
+}
+
+}  // namespace cellsph

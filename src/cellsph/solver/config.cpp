@@ -1,0 +1,92 @@
+#include "cellsph/solver/config.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "cellsph/core/error.hpp"
+
+namespace cellsph {
+
+namespace {
+template <class T>
+[[noreturn]] void bad(const std::string& key, const T& value, const char* why) {
+  std::ostringstream os;
+  os << "solver config: " << key << " = " << value << ": " << why;
+  throw InputError(os.str());
+}
+template <class Real>
+void positive(const std::string& key, Real v) {
+  if (!(std::isfinite(v) && v > 0)) bad(key, v, "must be a finite number > 0");
+}
+template <class Real>
+void non_negative(const std::string& key, Real v) {
+  if (!(std::isfinite(v) && v >= 0)) bad(key, v, "must be a finite number >= 0");
+}
+}  // namespace
+
+template <int Dim, class Real>
+void SolverConfig<Dim, Real>::validate() const {
+  positive("support", support);
+  positive("eos.stiffness", eos.stiffness);
+  if (eos.kind == EosKind::Tait) positive("eos.gamma", eos.gamma);
+  if (phases.empty()) bad("phases", "[]", "at least one phase is needed");
+  for (std::size_t k = 0; k < phases.size(); ++k) {
+    const std::string p = "phases[" + std::to_string(k) + "].";
+    positive(p + "rest_density", phases[k].rest_density);
+    non_negative(p + "mass", phases[k].mass);
+    non_negative(p + "viscosity", phases[k].viscosity);
+    if (!std::isfinite(phases[k].color)) bad(p + "color", phases[k].color, "must be finite");
+    non_negative(p + "sigma", phases[k].sigma);
+  }
+  non_negative("tension_threshold", tension_threshold);
+  for (int a = 0; a < Dim; ++a)
+    if (!std::isfinite(gravity[a])) bad("gravity[" + std::to_string(a) + "]", gravity[a], "must be finite");
+  positive("time.dt", time.dt);
+  positive("time.dt_max", time.dt_max);
+  positive("time.courant", time.courant);
+  positive("time.viscous", time.viscous);
+  positive("time.force", time.force);
+  if (box.enabled) {
+    for (int a = 0; a < Dim; ++a)
+      if (!(box.hi[a] - 2 * box.radius > box.lo[a]))
+        bad("box.hi[" + std::to_string(a) + "]", box.hi[a], "must exceed box.lo + 2 radius");
+    non_negative("box.radius", box.radius);
+    if (!(box.damping <= 0 && box.damping >= -1)) bad("box.damping", box.damping, "must be in [-1, 0]");
+  }
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    const Real n2 = norm2(planes[k].normal);
+    if (!(std::abs(n2 - 1) < Real(1e-3)))
+      bad("planes[" + std::to_string(k) + "].normal", std::sqrt(n2), "must have unit length");
+  }
+  if (!(restitution >= 0 && restitution <= 1)) bad("restitution", restitution, "must be in [0, 1]");
+  if (!(friction >= 0 && friction <= 1)) bad("friction", friction, "must be in [0, 1]");
+  if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
+}
+
+std::string_view model_name(Model m) { return m == Model::PaperMultiphase ? "paper" : "wcsph"; }
+std::optional<Model> parse_model(std::string_view n) {
+  if (n == "paper") return Model::PaperMultiphase;
+  if (n == "wcsph") return Model::Wcsph;
+  return std::nullopt;
+}
+std::string_view time_stepping_name(TimeStepping t) { return t == TimeStepping::Fixed ? "fixed" : "courant"; }
+std::optional<TimeStepping> parse_time_stepping(std::string_view n) {
+  if (n == "fixed") return TimeStepping::Fixed;
+  if (n == "courant") return TimeStepping::Courant;
+  return std::nullopt;
+}
+std::string_view density_formulation_name(DensityFormulation d) {
+  return d == DensityFormulation::Mass ? "mass" : "number";
+}
+std::optional<DensityFormulation> parse_density_formulation(std::string_view n) {
+  if (n == "mass") return DensityFormulation::Mass;
+  if (n == "number") return DensityFormulation::Number;
+  return std::nullopt;
+}
+
+template struct SolverConfig<2, float>;
+template struct SolverConfig<2, double>;
+template struct SolverConfig<3, float>;
+template struct SolverConfig<3, double>;
+
+}  // namespace cellsph

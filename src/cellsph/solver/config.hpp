@@ -1,0 +1,129 @@
+#pragma once
+// Everything a run of the solver needs to know, as plain data. Scene files fill it; validate() names the
+// key and the value of the first bad entry (InputError -> exit 2).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cellsph/core/vec.hpp"
+#include "cellsph/neighbors/neighbor_list.hpp"
+#include "cellsph/physics/eos.hpp"
+#include "cellsph/physics/kernels.hpp"
+
+namespace cellsph {
+
+// Which SPH model a step runs.
+enum class Model {
+  PaperMultiphase,  // Onderik & Durikovic 2007, Algorithm 1: eq. 7-9, leap-frog eq. 11
+  Wcsph,            // the CUDA write-up: operator splitting, symmetric pressure, symplectic Euler
+};
+
+// How the paper's model obtains densities of neighbours of another phase.
+enum class DensityFormulation {
+  Mass,    // eq. 7: rho_i = sum_j m_j W_ij (smears densities across a density jump)
+  Number,  // Solenthaler & Pajarola 2008: delta_i = sum_j W_ij, rho_i = m_i delta_i, V_i = 1 / delta_i
+};
+
+enum class TimeStepping {
+  Fixed,    // dt = time.dt every step (the paper's test)
+  Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
+};
+
+// One fluid (or boundary material): the phases table of a scene.
+template <class Real>
+struct Phase {
+  std::string name = "water";
+  Real rest_density = 1000;  // rho0 [kg/m^3]
+  Real mass = 0;             // particle mass [kg]; 0: rest_density * spacing^Dim where the scene fills blocks
+  Real viscosity = 0;        // dynamic viscosity mu [Pa s]
+  Real color = 1;            // interface colour value c^int (eq. 8c)
+  Real sigma = 0;            // interface / surface tension coefficient (eq. 9)
+};
+
+// A half-space wall: the fluid side is dot(normal, x) >= offset (normal of unit length, into the fluid).
+template <int Dim, class Real>
+struct Plane {
+  Vec<Dim, Real> normal{};
+  Real offset = 0;
+};
+
+template <int Dim, class Real>
+struct SolverConfig {
+  using V = Vec<Dim, Real>;
+
+  Model model = Model::PaperMultiphase;
+
+  // Kernels. Density uses `density_kernel` (the paper: poly6), pressure the gradient of `pressure_kernel`
+  // (the paper: spiky); the WCSPH model also uses that gradient in Monaghan's viscosity operator. The
+  // paper's viscosity (eq. 8b) always uses the viscosity kernel's Laplacian, whose positivity it relies
+  // on, and the colour field always uses poly6 (eq. 8c).
+  KernelKind density_kernel = KernelKind::Poly6;
+  KernelKind pressure_kernel = KernelKind::Spiky;
+  Real support = Real(0.05);  // h [m]: kernel support and neighbour radius (paper eq. 14)
+  DensityFormulation density = DensityFormulation::Mass;
+
+  EquationOfState<Real> eos{};
+  std::vector<Phase<Real>> phases{Phase<Real>{}};
+
+  // |grad C| below which no interface tension acts (Mueller 2003's threshold l; the write-up's 7.065).
+  Real tension_threshold = 0;
+  V gravity = gravity_default();
+
+  struct Time {
+    TimeStepping mode = TimeStepping::Fixed;
+    Real dt = Real(0.002);    // Fixed: the step [s]
+    Real dt_max = Real(0.01); // Courant: upper bound of the step [s]
+    Real courant = Real(0.3); // alpha of eq. 12
+    Real viscous = Real(0.125);  // dt <= viscous * h^2 rho0 / mu
+    Real force = Real(0.25);     // dt <= force * sqrt(h / |a|max)
+  } time{};
+
+  // The write-up's box: a particle that leaves [lo + r, hi - r] is put back on the wall and its normal
+  // velocity multiplied by `damping` (the write-up's BoundaryDamping = -0.5).
+  struct Box {
+    bool enabled = false;
+    V lo{}, hi{};
+    Real damping = Real(-0.5);
+    Real radius = 0;  // particle radius kept from the wall
+  } box{};
+
+  // The paper's walls (section 5): inelastic collision with restitution e, wet friction (tangential velocity
+  // reduced by a fixed fraction per contact, not by the normal impulse as dry Coulomb friction would) and
+  // projection of the particle back onto the wall to prevent overshooting.
+  std::vector<Plane<Dim, Real>> planes{};
+  Real restitution = Real(0.2);
+  Real friction = Real(0.1);
+
+  // Particles outside this box (grown by one support length) stop the run as unstable. If not set, the
+  // box above is used when enabled, otherwise the escape test is off.
+  bool domain_set = false;
+  V domain_lo{}, domain_hi{};
+
+  SearchOptions search{};
+  std::uint64_t seed = 1;
+
+  static constexpr V gravity_default() {
+    V g{};
+    g[Dim - 1] = Real(-9.81);
+    return g;
+  }
+
+  // Throws InputError naming the key and value of the first invalid entry.
+  void validate() const;
+};
+
+std::string_view model_name(Model m);
+std::optional<Model> parse_model(std::string_view name);
+std::string_view time_stepping_name(TimeStepping t);
+std::optional<TimeStepping> parse_time_stepping(std::string_view name);
+std::string_view density_formulation_name(DensityFormulation d);
+std::optional<DensityFormulation> parse_density_formulation(std::string_view name);
+
+extern template struct SolverConfig<2, float>;
+extern template struct SolverConfig<2, double>;
+extern template struct SolverConfig<3, float>;
+extern template struct SolverConfig<3, double>;
+
+}  // namespace cellsph

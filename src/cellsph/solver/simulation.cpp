@@ -1,0 +1,542 @@
+#include "cellsph/solver/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <limits>
+#include <ostream>
+#include <sstream>
+#include <string>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/core/timer.hpp"
+#include "cellsph/physics/interactions.hpp"
+#include "cellsph/physics/kernels.hpp"
+#include "cellsph/solver/boundaries.hpp"
+
+namespace cellsph {
+
+namespace {
+
+constexpr std::uint8_t kFluid = static_cast<std::uint8_t>(ParticleKind::Fluid);
+constexpr std::uint8_t kBoundary = static_cast<std::uint8_t>(ParticleKind::Boundary);
+
+template <class T>
+void put(std::ostream& out, const T& v) {
+  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <class T>
+T get(std::istream& in, const char* what) {
+  T v{};
+  in.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!in) throw InputError(std::string("checkpoint: truncated while reading ") + what);
+  return v;
+}
+
+constexpr char kMagic[8] = {'C', 'S', 'P', 'H', 'S', 'T', 'A', 'T'};
+
+}  // namespace
+
+template <int Dim, class Real>
+Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
+    : cfg_(std::move(config)), p_(std::move(particles)), search_(cfg_.search) {
+  cfg_.validate();
+  const std::size_t n = p_.x.size();
+  // Inputs that may be left empty get their defaults; any other size mismatch is an error.
+  auto complete = [n](auto& field, const char* name, auto value) {
+    if (field.empty()) field.assign(n, value);
+    if (field.size() != n) {
+      std::ostringstream os;
+      os << "particles: field '" << name << "' has " << field.size() << " entries, positions have " << n;
+      throw InputError(os.str());
+    }
+  };
+  complete(p_.v, "velocity", V{});
+  complete(p_.m, "mass", Real(0));
+  complete(p_.phase, "phase", std::int32_t{0});
+  complete(p_.kind, "kind", kFluid);
+  p_.f.assign(n, V{});
+  p_.rho.assign(n, Real(0));
+  p_.p.assign(n, Real(0));
+  p_.h.assign(n, cfg_.support);
+  p_.color.assign(n, Real(0));
+  p_.mu.assign(n, Real(0));
+  complete(p_.level, "level", std::int32_t{0});
+  rho0_.assign(n, Real(0));
+
+  fluid_count_ = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto ph = p_.phase[i];
+    if (ph < 0 || static_cast<std::size_t>(ph) >= cfg_.phases.size()) {
+      std::ostringstream os;
+      os << "particles: particle " << i << " has phase " << ph << ", the phase table has "
+         << cfg_.phases.size() << " entries";
+      throw InputError(os.str());
+    }
+    if (p_.kind[i] != kFluid && p_.kind[i] != kBoundary) {
+      std::ostringstream os;
+      os << "particles: particle " << i << " has kind " << int(p_.kind[i]) << " (0 fluid, 1 boundary)";
+      throw InputError(os.str());
+    }
+    if (!all_finite(p_.x[i]) || !all_finite(p_.v[i])) {
+      std::ostringstream os;
+      os << "particles: particle " << i << " has a non-finite position or velocity";
+      throw InputError(os.str());
+    }
+    const auto& phase = cfg_.phases[static_cast<std::size_t>(ph)];
+    rho0_[i] = phase.rest_density;
+    p_.rho[i] = phase.rest_density;
+    p_.color[i] = phase.color;
+    p_.mu[i] = phase.viscosity;
+    if (p_.kind[i] == kFluid) {
+      ++fluid_count_;
+      if (p_.m[i] <= 0) p_.m[i] = phase.mass;
+      if (!(p_.m[i] > 0 && std::isfinite(p_.m[i]))) {
+        std::ostringstream os;
+        os << "particles: fluid particle " << i << " has mass " << p_.m[i] << " and phase '" << phase.name
+           << "' gives none (phases[" << ph << "].mass)";
+        throw InputError(os.str());
+      }
+    } else {
+      p_.v[i] = V{};
+    }
+  }
+  for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
+  f_pressure_.assign(n, V{});
+  init_boundary_weights();
+}
+
+// Akinci et al. 2012: V_b = 1 / sum_k W_bk over boundary particles (self included), psi_b = rho0 V_b.
+// Irregular sampling of a wall then still gives the same density contribution per unit area.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::init_boundary_weights() {
+  if (fluid_count_ == p_.size()) return;
+  compute_neighbors();
+  with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
+    parallel_for(p_.size(), [&](std::size_t b) {
+      if (p_.kind[b] != kBoundary) return;
+      Real s = w.W2(0);
+      for (const auto* it = nl_.begin(b); it != nl_.end(b); ++it)
+        if (p_.kind[*it] == kBoundary) s += w.W2(distance2(p_.x[b], p_.x[*it]));
+      p_.m[b] = rho0_[b] / s;
+    });
+  });
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_neighbors() {
+  search_.build(std::span<const V>(p_.x), std::span<const Real>(p_.h));
+  search_.find_all(nl_);
+}
+
+// Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_density_pressure() {
+  const bool number = cfg_.density == DensityFormulation::Number && cfg_.model == Model::PaperMultiphase;
+  with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
+    parallel_for(p_.size(), [&](std::size_t i) {
+      if (p_.kind[i] != kFluid) return;
+      const V xi = p_.x[i];
+      Real rho = 0;
+      if (number) {
+        // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
+        // is not given the heavy one's density.
+        Real delta = w.W2(0);
+        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+          const std::uint32_t j = *it;
+          const Real wij = w.W2(distance2(xi, p_.x[j]));
+          delta += p_.kind[j] == kFluid ? wij : wij * p_.m[j] / rho0_[i];
+        }
+        rho = p_.m[i] * delta;
+      } else {
+        rho = density_term(w, p_.m[i], Real(0));
+        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it)
+          rho += density_term(w, p_.m[*it], distance2(xi, p_.x[*it]));
+      }
+      p_.rho[i] = rho;
+      p_.p[i] = cfg_.eos.pressure(rho, rho0_[i]);
+    });
+  });
+}
+
+// Algorithm 1, lines 2-15: f_i = m_i g + eq. 8a + eq. 8b + eq. 9.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_forces_paper() {
+  const Poly6Kernel<Dim, Real> wc(cfg_.support);
+  const ViscosityKernel<Dim, Real> wv(cfg_.support);
+  const Real lap_self = wc.laplacian(0);
+  with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wp) {
+    parallel_for(p_.size(), [&](std::size_t i) {
+      if (p_.kind[i] != kFluid) {
+        p_.f[i] = V{};
+        return;
+      }
+      const Real vol_i = p_.m[i] / p_.rho[i];
+      V f = cfg_.gravity * p_.m[i];
+      // The colour field includes particle i itself (its Laplacian does not vanish at r = 0), so that it
+      // is ~0 inside a uniform phase.
+      ColorField<Dim, Real> cf;
+      cf.lap = vol_i * p_.color[i] * lap_self;
+      PairInput<Dim, Real> in{};
+      in.mi = p_.m[i];
+      in.rhoi = p_.rho[i];
+      in.pi = p_.p[i];
+      in.mui = p_.mu[i];
+      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        const std::uint32_t j = *it;
+        in.xij = p_.x[i] - p_.x[j];
+        in.r = norm(in.xij);
+        if (p_.kind[j] == kFluid) {
+          in.vij = p_.v[i] - p_.v[j];
+          in.mj = p_.m[j];
+          in.rhoj = p_.rho[j];
+          in.pj = p_.p[j];
+          in.muj = p_.mu[j];
+          f += averaged_pressure_force(in, wp);
+          f += averaged_viscosity_force(in, wv);
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], p_.color[j], wc);
+        } else {
+          // A boundary particle acts as fluid at rest density with i's own pressure (mirrored) and i's
+          // colour (walls are neutral to interface tension). Walls are free-slip: no viscosity.
+          in.mj = p_.m[j];
+          in.rhoj = rho0_[i];
+          in.pj = p_.p[i];
+          f += averaged_pressure_force(in, wp);
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / rho0_[i], p_.color[i], wc);
+        }
+      }
+      if (any_tension_) {
+        const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
+        f += interface_tension_force(cf, ph.sigma, cfg_.tension_threshold);
+      }
+      p_.f[i] = f;
+    });
+  });
+}
+
+// The write-up's loop: non-pressure forces (Monaghan viscosity, gravity, Mueller surface tension) and the
+// symmetric pressure force, kept apart so that the integrator can apply them in two sub-steps.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_forces_wcsph() {
+  const Poly6Kernel<Dim, Real> wc(cfg_.support);
+  const Real lap_self = wc.laplacian(0);
+  const Real h = cfg_.support;
+  with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wg) {
+    parallel_for(p_.size(), [&](std::size_t i) {
+      if (p_.kind[i] != kFluid) {
+        p_.f[i] = V{};
+        f_pressure_[i] = V{};
+        return;
+      }
+      const Real vol_i = p_.m[i] / p_.rho[i];
+      V fnp = cfg_.gravity * p_.m[i];
+      V fp{};
+      ColorField<Dim, Real> cf;
+      cf.lap = vol_i * lap_self;
+      PairInput<Dim, Real> in{};
+      in.mi = p_.m[i];
+      in.rhoi = p_.rho[i];
+      in.pi = p_.p[i];
+      in.mui = p_.mu[i];
+      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        const std::uint32_t j = *it;
+        in.xij = p_.x[i] - p_.x[j];
+        in.r = norm(in.xij);
+        if (p_.kind[j] == kFluid) {
+          in.vij = p_.v[i] - p_.v[j];
+          in.mj = p_.m[j];
+          in.rhoj = p_.rho[j];
+          in.pj = p_.p[j];
+          in.muj = p_.mu[j];
+          fnp += monaghan_viscosity_force(in, wg, h);
+          fp += symmetric_pressure_force(in, wg);
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], Real(1), wc);
+        } else {
+          fp += boundary_pressure_force(in.xij, in.mi, in.rhoi, in.pi, p_.m[j], wg);
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / rho0_[i], Real(1), wc);
+        }
+      }
+      if (any_tension_) {
+        // Mueller 2003 gives a force density; the particle's share is V_i times it.
+        const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
+        fnp += interface_tension_force(cf, ph.sigma, cfg_.tension_threshold) * vol_i;
+      }
+      p_.f[i] = fnp;
+      f_pressure_[i] = fp;
+    });
+  });
+}
+
+// Fixed, or the global Courant step: eq. 12 (alpha h / c and alpha h / |v|), the viscous limit
+// viscous * h^2 / nu and the force limit force * sqrt(h / |a|), capped at dt_max.
+template <int Dim, class Real>
+Real Simulation<Dim, Real>::choose_dt() const {
+  if (cfg_.time.mode == TimeStepping::Fixed) return cfg_.time.dt;
+  const Real h = cfg_.support;
+  const Real alpha = cfg_.time.courant;
+  Real dt = cfg_.time.dt_max;
+  Real rho0_min = std::numeric_limits<Real>::max(), nu_max = 0;
+  for (const auto& ph : cfg_.phases) {
+    rho0_min = std::min(rho0_min, ph.rest_density);
+    nu_max = std::max(nu_max, ph.viscosity / ph.rest_density);
+  }
+  dt = std::min(dt, alpha * h / cfg_.eos.sound_speed(rho0_min));
+  if (nu_max > 0) dt = std::min(dt, cfg_.time.viscous * h * h / nu_max);
+  Real v2 = 0, a2 = 0;
+  const bool wcsph = cfg_.model == Model::Wcsph;
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    if (p_.kind[i] != kFluid) continue;
+    v2 = std::max(v2, norm2(p_.v[i]));
+    const V f = wcsph ? p_.f[i] + f_pressure_[i] : p_.f[i];
+    a2 = std::max(a2, norm2(f) / (p_.m[i] * p_.m[i]));
+  }
+  if (v2 > 0) dt = std::min(dt, alpha * h / std::sqrt(v2));
+  if (a2 > 0) dt = std::min(dt, cfg_.time.force * std::sqrt(h / std::sqrt(a2)));
+  return dt;
+}
+
+// Leap-frog (eq. 11). On the first step v(t0) becomes v(t0 - dt/2) = v(t0) - dt/2 a(t0), so that the
+// kick below lands on v(t0 + dt/2). With a changing step the kick uses the mean of the old and new step,
+// which keeps the velocity at the midpoints of the position steps.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::integrate_paper(Real dt) {
+  const Real kick = leapfrog_started_ ? (last_dt_ + dt) / 2 : dt / 2;
+  parallel_for(p_.size(), [&](std::size_t i) {
+    if (p_.kind[i] != kFluid) return;
+    p_.v[i] += p_.f[i] * (kick / p_.m[i]);
+    p_.x[i] += p_.v[i] * dt;
+  });
+  leapfrog_started_ = true;
+}
+
+// The write-up's split: v* = v + dt (F_visc + F_ext)/m, then v(t+dt) = v* + dt F_press/m,
+// x(t+dt) = x + dt v(t+dt) (symplectic Euler).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::integrate_wcsph(Real dt) {
+  parallel_for(p_.size(), [&](std::size_t i) {
+    if (p_.kind[i] != kFluid) return;
+    const V vstar = p_.v[i] + p_.f[i] * (dt / p_.m[i]);
+    p_.v[i] = vstar + f_pressure_[i] * (dt / p_.m[i]);
+    p_.x[i] += p_.v[i] * dt;
+    p_.f[i] += f_pressure_[i];  // the total force, for output and the force limit of the next step
+  });
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::apply_walls() {
+  if (!cfg_.box.enabled && cfg_.planes.empty()) return;
+  parallel_for(p_.size(), [&](std::size_t i) {
+    if (p_.kind[i] != kFluid) return;
+    if (cfg_.box.enabled)
+      box_collision(p_.x[i], p_.v[i], cfg_.box.lo, cfg_.box.hi, cfg_.box.radius, cfg_.box.damping);
+    for (const auto& pl : cfg_.planes)
+      plane_collision(p_.x[i], p_.v[i], pl.normal, pl.offset, cfg_.restitution, cfg_.friction);
+  });
+}
+
+// After each step: the first particle (lowest index) with a non-finite quantity or outside the domain
+// stops the run with a diagnosis.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::check_state() const {
+  const std::size_t n = p_.size();
+  V lo{}, hi{};
+  bool escape = false;
+  if (cfg_.domain_set) {
+    lo = cfg_.domain_lo;
+    hi = cfg_.domain_hi;
+    escape = true;
+  } else if (cfg_.box.enabled) {
+    lo = cfg_.box.lo;
+    hi = cfg_.box.hi;
+    escape = true;
+  }
+  const Real margin = cfg_.support;
+  auto bad = [&](std::size_t i) {
+    if (!all_finite(p_.x[i]) || !all_finite(p_.v[i]) || !all_finite(p_.f[i])) return true;
+    if (!std::isfinite(p_.rho[i]) || !std::isfinite(p_.p[i])) return true;
+    if (escape)
+      for (int a = 0; a < Dim; ++a)
+        if (p_.x[i][a] < lo[a] - margin || p_.x[i][a] > hi[a] + margin) return true;
+    return false;
+  };
+  std::int64_t first = std::numeric_limits<std::int64_t>::max();
+  const auto count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) reduction(min : first)
+  for (std::int64_t i = 0; i < count; ++i)
+    if (p_.kind[static_cast<std::size_t>(i)] == kFluid && bad(static_cast<std::size_t>(i)))
+      first = std::min(first, i);
+  if (first == std::numeric_limits<std::int64_t>::max()) return;
+
+  const auto i = static_cast<std::size_t>(first);
+  std::ostringstream os;
+  os.precision(9);
+  os << "simulation unstable at step " << steps_ + 1 << " (t = " << time_ << " s): particle " << i << ": ";
+  auto vec = [&](const char* name, const V& v) {
+    os << name << " = (";
+    for (int a = 0; a < Dim; ++a) os << (a ? ", " : "") << v[a];
+    os << ")";
+  };
+  if (!all_finite(p_.x[i])) vec("position", p_.x[i]);
+  else if (!all_finite(p_.v[i])) vec("velocity", p_.v[i]);
+  else if (!all_finite(p_.f[i])) vec("force", p_.f[i]);
+  else if (!std::isfinite(p_.rho[i])) os << "density = " << p_.rho[i];
+  else if (!std::isfinite(p_.p[i])) os << "pressure = " << p_.p[i];
+  else {
+    vec("position", p_.x[i]);
+    os << " left the domain";
+    vec(" [lo", lo);
+    vec(", hi", hi);
+    os << "] (margin " << margin << " m)";
+  }
+  throw SimulationError(os.str());
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::step() {
+  Stopwatch sw;
+  compute_neighbors();
+  timings_.neighbors += sw.ms();
+
+  sw.reset();
+  compute_density_pressure();
+  if (cfg_.model == Model::PaperMultiphase) compute_forces_paper();
+  else compute_forces_wcsph();
+  timings_.forces += sw.ms();
+
+  sw.reset();
+  const Real dt = choose_dt();
+  if (cfg_.model == Model::PaperMultiphase) integrate_paper(dt);
+  else integrate_wcsph(dt);
+  apply_walls();
+  check_state();
+  time_ += dt;
+  last_dt_ = dt;
+  ++steps_;
+  timings_.integration += sw.ms();
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::run_until(Real t_end) {
+  while (time_ < t_end) step();
+}
+
+template <int Dim, class Real>
+auto Simulation<Dim, Real>::momentum() const -> V {
+  V s{};
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (p_.kind[i] == kFluid) s += p_.v[i] * p_.m[i];
+  return s;
+}
+
+template <int Dim, class Real>
+Real Simulation<Dim, Real>::kinetic_energy() const {
+  Real s = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (p_.kind[i] == kFluid) s += p_.m[i] * norm2(p_.v[i]) / 2;
+  return s;
+}
+
+template <int Dim, class Real>
+Real Simulation<Dim, Real>::total_mass() const {
+  Real s = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (p_.kind[i] == kFluid) s += p_.m[i];
+  return s;
+}
+
+// Layout: magic, version, Dim, sizeof(Real), particle count, integrator state, then for every field of
+// the field list: name, element size, element count, raw bytes.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::save_state(std::ostream& out) const {
+  out.write(kMagic, sizeof kMagic);
+  put(out, kStateVersion);
+  put(out, std::int32_t{Dim});
+  put(out, static_cast<std::uint32_t>(sizeof(Real)));
+  put(out, static_cast<std::uint64_t>(p_.size()));
+  put(out, time_);
+  put(out, last_dt_);
+  put(out, steps_);
+  put(out, static_cast<std::uint8_t>(leapfrog_started_));
+  std::uint32_t nfields = 0;
+  p_.for_each_field([&](std::string_view, const auto&) { ++nfields; });
+  put(out, nfields);
+  p_.for_each_field([&](std::string_view name, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    put(out, static_cast<std::uint32_t>(name.size()));
+    out.write(name.data(), static_cast<std::streamsize>(name.size()));
+    put(out, static_cast<std::uint32_t>(sizeof(T)));
+    put(out, static_cast<std::uint64_t>(field.size()));
+    out.write(reinterpret_cast<const char*>(field.data()), static_cast<std::streamsize>(field.size() * sizeof(T)));
+  });
+  if (!out) throw InputError("checkpoint: write failed");
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::load_state(std::istream& in) {
+  char magic[sizeof kMagic];
+  in.read(magic, sizeof magic);
+  if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw InputError("checkpoint: not a cellsph state file (bad magic)");
+  const auto version = get<std::uint32_t>(in, "version");
+  if (version != kStateVersion) {
+    throw InputError("checkpoint: format version " + std::to_string(version) + ", this build reads " +
+                     std::to_string(kStateVersion));
+  }
+  const auto dim = get<std::int32_t>(in, "dimension");
+  const auto real = get<std::uint32_t>(in, "precision");
+  if (dim != Dim || real != sizeof(Real)) {
+    throw InputError("checkpoint: written for " + std::to_string(dim) + "D with " + std::to_string(real) +
+                     "-byte reals, this run is " + std::to_string(Dim) + "D with " +
+                     std::to_string(sizeof(Real)) + "-byte reals");
+  }
+  const auto n = get<std::uint64_t>(in, "particle count");
+  if (n != p_.size()) {
+    throw InputError("checkpoint: holds " + std::to_string(n) + " particles, the scene has " +
+                     std::to_string(p_.size()));
+  }
+  const Real t = get<Real>(in, "time");
+  const Real ldt = get<Real>(in, "last dt");
+  const auto st = get<std::uint64_t>(in, "steps");
+  const auto started = get<std::uint8_t>(in, "integrator state");
+  const auto nfields = get<std::uint32_t>(in, "field count");
+  std::uint32_t expected = 0;
+  p_.for_each_field([&](std::string_view, const auto&) { ++expected; });
+  if (nfields != expected) {
+    throw InputError("checkpoint: has " + std::to_string(nfields) + " fields, this build has " +
+                     std::to_string(expected));
+  }
+  Particles<Dim, Real> loaded = p_;
+  loaded.for_each_field([&](std::string_view name, auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    const auto len = get<std::uint32_t>(in, "field name");
+    std::string got(len, '\0');
+    in.read(got.data(), len);
+    if (!in || got != name)
+      throw InputError("checkpoint: expected field '" + std::string(name) + "', found '" + got + "'");
+    const auto size = get<std::uint32_t>(in, "element size");
+    const auto count = get<std::uint64_t>(in, "element count");
+    if (size != sizeof(T) || count != n)
+      throw InputError("checkpoint: field '" + std::string(name) + "' has a wrong element size or count");
+    field.resize(count);
+    in.read(reinterpret_cast<char*>(field.data()), static_cast<std::streamsize>(count * sizeof(T)));
+    if (!in) throw InputError("checkpoint: truncated in field '" + std::string(name) + "'");
+  });
+  p_ = std::move(loaded);
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    rho0_[i] = cfg_.phases[static_cast<std::size_t>(std::clamp<std::int32_t>(p_.phase[i], 0,
+                                                       static_cast<std::int32_t>(cfg_.phases.size()) - 1))]
+                   .rest_density;
+  time_ = t;
+  last_dt_ = ldt;
+  steps_ = st;
+  leapfrog_started_ = started != 0;
+}
+
+template class Simulation<2, float>;
+template class Simulation<2, double>;
+template class Simulation<3, float>;
+template class Simulation<3, double>;
+
+}  // namespace cellsph
