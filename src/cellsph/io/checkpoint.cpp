@@ -1,5 +1,6 @@
 #include "cellsph/io/checkpoint.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <fstream>
@@ -79,6 +80,9 @@ class Cursor {
     pos_ += n;
     return s;
   }
+  [[nodiscard]] std::string_view peek(std::size_t n) const {
+    return {bytes_.data() + pos_, std::min(n, end_ - pos_)};
+  }
   [[nodiscard]] std::size_t pos() const { return pos_; }
 
  private:
@@ -103,6 +107,9 @@ std::string read_all(const std::filesystem::path& path) {
 }
 
 CheckpointHeader parse_header(Cursor& c) {
+  // A short file that does not even start like a checkpoint is "not a checkpoint", not "truncated".
+  const auto head = c.peek(sizeof(kMagic));
+  if (std::memcmp(head.data(), kMagic, head.size()) != 0) c.fail("bad magic number: not a cellsph checkpoint");
   const auto magic = c.get_bytes(sizeof(kMagic), "the magic number");
   if (std::memcmp(magic.data(), kMagic, sizeof(kMagic)) != 0) c.fail("bad magic number: not a cellsph checkpoint");
   CheckpointHeader h;
