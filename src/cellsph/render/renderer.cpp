@@ -406,7 +406,7 @@ Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const 
     box_edges(Dim, box, edges);
     const double bias = 1e-3 * std::sqrt(dot(diag, diag));
     for (const auto& [a, b] : edges)
-      draw_segment(fb, vs.view, a, b, 1.6 * ss * layout.font / 1.5, {70, 70, 70}, Dim == 3, bias);
+      draw_segment(fb, vs.view, a, b, ss * std::max(2.0, 1.1 * layout.font), {70, 70, 70}, Dim == 3, bias);
   }
   Image img = downsample(fb, ss);
 
