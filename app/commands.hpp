@@ -7,5 +7,6 @@ namespace cellsph::app {
 
 void register_neighbors(CLI::App& app, int& result);
 void register_bench(CLI::App& app, int& result);
+void register_run(CLI::App& app, int& result);
 
 }  // namespace cellsph::app

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   int result = 0;
   cellsph::app::register_neighbors(app, result);
   cellsph::app::register_bench(app, result);
+  cellsph::app::register_run(app, result);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,281 @@
+// `cellsph run [SCENE]` and `cellsph scenes`: run a scene from the command line, writing frames that
+// ParaView (VTU + PVD), Blender (PLY) and scripts (CSV, frames.csv) open, optional PNG pictures and an
+// MP4, checkpoints, and a resume that continues bit for bit.
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cellsph/core/atomic_file.hpp"
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/core/timer.hpp"
+#include "cellsph/io/frame_output.hpp"
+#include "cellsph/render/renderer.hpp"
+#include "cellsph/render/video.hpp"
+#include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/scene/json_reader.hpp"
+#include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/simulation.hpp"
+#include "commands.hpp"
+#include "progress.hpp"
+
+namespace cellsph::app {
+namespace {
+
+constexpr const char* kDefaultScene = "dam-break-2d";
+constexpr const char* kRunFile = "run.json";
+constexpr const char* kCheckpointFile = "checkpoint.bin";
+constexpr std::uint32_t kRunCheckpointVersion = 1;
+constexpr char kRunMagic[8] = {'C', 'S', 'P', 'H', 'R', 'U', 'N', '1'};
+
+struct RunOptions {
+  std::string scene;
+  std::string out;
+  int threads = 0;
+  std::string method;
+  double until = -1;
+  long steps = -1;
+  double fps = -1;
+  std::string formats;
+  bool render = false;
+  std::string color_by;
+  bool quiet = false;
+  std::string resume;
+};
+
+// The state of the run loop that a checkpoint stores besides the simulation.
+struct LoopState {
+  std::uint64_t next_frame = 0;
+};
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+template <int Dim, class Real>
+int run_scene(const nlohmann::json& scene_json, const std::string& source, const RunOptions& opt,
+              const std::filesystem::path& out, bool resuming) {
+  Scene<Dim, Real> scene = load_scene<Dim, Real>(scene_json, source);
+  auto& cfg = scene.solver;
+  if (!opt.method.empty()) {
+    auto m = parse_method(opt.method);
+    if (!m) throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() + ")");
+    cfg.search.method = *m;
+  }
+  OutputSettings os = scene.output;
+  if (opt.until > 0) os.end_time = opt.until;
+  if (opt.fps > 0) os.fps = opt.fps;
+  OutputFormats formats;
+  if (!opt.formats.empty()) {
+    formats = parse_output_formats(opt.formats, "--format");
+  } else {
+    std::string list;
+    for (const auto& f : os.formats) list += (list.empty() ? "" : ",") + f;
+    formats = list.empty() ? OutputFormats{} : parse_output_formats(list, "output.formats");
+  }
+  if (!opt.color_by.empty()) os.color_by = opt.color_by;
+
+  std::filesystem::create_directories(out);
+  Simulation<Dim, Real> sim(cfg, std::move(scene.particles));
+  const auto& parts = sim.particles();
+  auto is_fluid = [&parts](std::size_t i) { return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid); };
+  FrameOutput<Dim, Real> frames(out, formats, is_fluid);
+
+  LoopState loop;
+  const auto ckpt_path = out / kCheckpointFile;
+  if (resuming) {
+    std::ifstream in(ckpt_path, std::ios::binary);
+    if (!in) throw InputError(ckpt_path.string() + ": no checkpoint to resume from");
+    char magic[8];
+    std::uint32_t version = 0;
+    in.read(magic, 8);
+    in.read(reinterpret_cast<char*>(&version), sizeof version);
+    in.read(reinterpret_cast<char*>(&loop.next_frame), sizeof loop.next_frame);
+    if (!in || std::memcmp(magic, kRunMagic, 8) != 0)
+      throw InputError(ckpt_path.string() + ": not a cellsph run checkpoint");
+    if (version != kRunCheckpointVersion)
+      throw InputError(ckpt_path.string() + ": checkpoint format version " + std::to_string(version) +
+                       ", this cellsph reads version " + std::to_string(kRunCheckpointVersion));
+    sim.load_state(in);
+    frames.resume(loop.next_frame);
+  }
+
+  RenderOptions ropt;
+  ropt.color_by = parse_color_by(os.color_by, "--color-by");
+  ropt.up_axis = os.up_axis;
+  ropt.visible = is_fluid;
+  RenderBox rbox;
+  rbox.lo = scene.view_lo;
+  rbox.hi = scene.view_hi;
+  const auto png_dir = out / "png";
+  if (opt.render) std::filesystem::create_directories(png_dir);
+
+  Progress progress(opt.quiet);
+  Stopwatch wall;
+  double output_ms = 0;
+  const std::uint64_t steps_at_start = sim.steps();
+  const double t_at_start = double(sim.time());
+  const double frame_dt = 1.0 / os.fps;
+
+  auto write_frame = [&] {
+    Stopwatch sw;
+    const double t = double(sim.time());
+    if (formats.any()) frames.write(sim.particles(), loop.next_frame, t);
+    if (opt.render) render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
+    ++loop.next_frame;
+    if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0) {
+      AtomicFile f(ckpt_path, true);
+      f.stream().write(kRunMagic, 8);
+      f.stream().write(reinterpret_cast<const char*>(&kRunCheckpointVersion), sizeof kRunCheckpointVersion);
+      f.stream().write(reinterpret_cast<const char*>(&loop.next_frame), sizeof loop.next_frame);
+      sim.save_state(f.stream());
+      f.commit();
+    }
+    output_ms += sw.ms();
+  };
+
+  if (!opt.quiet)
+    std::fprintf(stderr, "cellsph: %s (%s): %zu particles (%zu fluid), %dD %s, %s, %s, %d threads -> %s\n",
+                 scene.header.name.c_str(), source.c_str(), sim.particles().size(), sim.fluid_count(), Dim,
+                 sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
+                 std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
+
+  if (!resuming) write_frame();
+  auto done = [&] {
+    if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
+    return double(sim.time()) >= os.end_time * (1 - 1e-12);
+  };
+  while (!done()) {
+    sim.step();
+    while (double(sim.time()) >= double(loop.next_frame) * frame_dt * (1 - 1e-12)) write_frame();
+    const double frac = opt.steps >= 0 ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
+                                       : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
+    const double w = wall.seconds();
+    progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) + " s  frame " +
+                              std::to_string(loop.next_frame) + "  " +
+                              fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) + " steps/s  " +
+                              std::to_string(sim.fluid_count()) + " fluid particles");
+  }
+  progress.finish();
+
+  if (opt.render && !opt.quiet) {
+    const auto v = make_mp4(png_dir, "frame_%05d.png", os.fps, out / "movie.mp4");
+    std::fprintf(stderr, "cellsph: %s\n", v.message.c_str());
+  }
+
+  if (!opt.quiet) {
+    const double w = wall.seconds();
+    const auto& tm = sim.timings();
+    const std::uint64_t steps = sim.steps() - steps_at_start;
+    const double total_ms = tm.neighbors + tm.forces + tm.integration + output_ms;
+    auto pct = [&](double ms) { return fmt("%.0f%%", 100.0 * ms / std::max(total_ms, 1e-9)); };
+    std::fprintf(stderr,
+                 "cellsph: done: simulated %.4g s in %s wall, %llu steps (mean dt %.3g s), %llu frames in %s\n"
+                 "         time split: neighbours %s, forces %s, integration %s, output %s\n",
+                 double(sim.time()), Progress::format_duration(w).c_str(), static_cast<unsigned long long>(steps),
+                 steps ? (double(sim.time()) - t_at_start) / double(steps) : 0.0,
+                 static_cast<unsigned long long>(loop.next_frame), out.string().c_str(), pct(tm.neighbors).c_str(),
+                 pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
+  }
+  return 0;
+}
+
+int run_command(RunOptions opt) {
+  nlohmann::json scene_json;
+  std::string source;
+  std::filesystem::path out;
+  bool resuming = false;
+  if (!opt.resume.empty()) {
+    // Resume: the scene and the options of the original run come from DIR/run.json.
+    out = opt.resume;
+    const auto run_file = out / kRunFile;
+    if (!std::filesystem::exists(run_file))
+      throw InputError("--resume " + out.string() + ": no " + kRunFile + " there (not a cellsph output folder)");
+    const auto saved = JsonReader::parse_file(run_file);
+    try {
+      scene_json = saved.at("scene");
+      source = saved.at("source").get<std::string>();
+      const auto& o = saved.at("options");
+      if (opt.method.empty()) opt.method = o.at("method").get<std::string>();
+      if (opt.fps <= 0) opt.fps = o.at("fps").get<double>();
+      if (opt.formats.empty()) opt.formats = o.at("formats").get<std::string>();
+      if (opt.until <= 0) opt.until = o.at("until").get<double>();
+      if (opt.steps < 0) opt.steps = o.at("steps").get<long>();
+      if (!opt.render) opt.render = o.at("render").get<bool>();
+      if (opt.color_by.empty()) opt.color_by = o.at("color_by").get<std::string>();
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(run_file.string() + ": damaged (" + e.what() + ")");
+    }
+    resuming = true;
+  } else {
+    if (opt.scene.empty()) opt.scene = kDefaultScene;
+    scene_json = read_scene_json(opt.scene, source);
+  }
+  const SceneHeader header = read_scene_header(scene_json, source);
+  if (out.empty()) out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
+
+  ScopedThreads threads(opt.threads);
+  if (!resuming) {
+    std::filesystem::create_directories(out);
+    nlohmann::json saved;
+    saved["scene"] = scene_json;
+    saved["source"] = source;
+    saved["options"] = {{"method", opt.method}, {"fps", opt.fps},   {"formats", opt.formats},
+                        {"until", opt.until},   {"steps", opt.steps}, {"render", opt.render},
+                        {"color_by", opt.color_by}};
+    write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
+  }
+  if (header.dim == 2)
+    return header.single_precision ? run_scene<2, float>(scene_json, source, opt, out, resuming)
+                                   : run_scene<2, double>(scene_json, source, opt, out, resuming);
+  return header.single_precision ? run_scene<3, float>(scene_json, source, opt, out, resuming)
+                                 : run_scene<3, double>(scene_json, source, opt, out, resuming);
+}
+
+}  // namespace
+
+void register_run(CLI::App& app, int& result) {
+  auto opt = std::make_shared<RunOptions>();
+  auto* sub = app.add_subcommand("run", "Run a scene (built-in name or JSON file; default: " +
+                                            std::string(kDefaultScene) + ")");
+  sub->add_option("scene", opt->scene, "Built-in scene name (see `cellsph scenes`) or a scene .json file");
+  sub->add_option("--out", opt->out, "Output folder (default: a folder named after the scene)");
+  sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::PositiveNumber);
+  sub->add_option("--method", opt->method,
+                  "Neighbour search: " + method_names_joined() + " (default: the scene's, else cell-index)");
+  sub->add_option("--until", opt->until, "Simulated end time in seconds (default: the scene's time.end)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--steps", opt->steps, "Stop after this many steps instead of at an end time")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--fps", opt->fps, "Output frames per simulated second (default: the scene's output.fps)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--format", opt->formats, "Frame formats, any of vtu,ply,csv (default: the scene's output.formats)");
+  sub->add_flag("--render", opt->render, "Also write a PNG picture per frame (and an MP4 if ffmpeg is installed)");
+  sub->add_option("--color-by", opt->color_by, "Picture colours: phase, speed or pressure (default: the scene's)");
+  sub->add_flag("--quiet", opt->quiet, "No progress line and no summary");
+  sub->add_option("--resume", opt->resume, "Continue the run in this output folder from its last checkpoint");
+  sub->callback([opt, &result] { result = run_command(*opt); });
+
+  auto* scenes = app.add_subcommand("scenes", "List the built-in scenes");
+  scenes->callback([&result] {
+    for (const auto& s : builtin_scenes()) {
+      std::string src;
+      const auto j = read_scene_json(std::string(s.name), src);
+      const auto h = read_scene_header(j, src);
+      std::printf("%-22s %dD  %s\n", std::string(s.name).c_str(), h.dim, h.description.c_str());
+    }
+    result = 0;
+  });
+}
+
+}  // namespace cellsph::app

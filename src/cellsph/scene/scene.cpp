@@ -1,0 +1,393 @@
+#include "cellsph/scene/scene.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/scene/json_reader.hpp"
+#include "cellsph/solver/initial.hpp"
+
+namespace cellsph {
+
+nlohmann::json read_scene_json(const std::string& name_or_path, std::string& source) {
+  for (const auto& s : builtin_scenes()) {
+    if (s.name == name_or_path) {
+      source = "built-in scene " + std::string(s.name);
+      try {
+        return nlohmann::json::parse(s.json);
+      } catch (const nlohmann::json::parse_error& e) {
+        throw InputError(source + ": invalid JSON: " + e.what());
+      }
+    }
+  }
+  const std::filesystem::path p(name_or_path);
+  if (!std::filesystem::exists(p)) {
+    std::string names;
+    for (const auto& s : builtin_scenes()) names += (names.empty() ? "" : ", ") + std::string(s.name);
+    throw InputError("'" + name_or_path + "' is neither a built-in scene (" + names +
+                     ") nor an existing scene file");
+  }
+  source = p.string();
+  return JsonReader::parse_file(p);
+}
+
+SceneHeader read_scene_header(const nlohmann::json& j, const std::string& source) {
+  if (!j.is_object()) throw InputError(source + ": /: a scene must be a JSON object, got " + json_value_text(j));
+  JsonReader r(j, source, "");
+  SceneHeader h;
+  h.name = r.string("name", "scene");
+  if (h.name.empty()) r.fail("name", "must not be empty");
+  for (char c : h.name)
+    if (c == '/' || c == '\\') r.fail("name", "must not contain a path separator, got \"" + h.name + "\"");
+  h.description = r.string("description", "");
+  h.dim = static_cast<int>(r.integer("dimension", 2, 2, 3));
+  h.single_precision = r.choice("precision", "double", {"double", "float"}) == "float";
+  return h;
+}
+
+namespace {
+
+template <int Dim, class Real>
+Vec<Dim, Real> to_vec(const std::vector<double>& v) {
+  Vec<Dim, Real> out;
+  for (int a = 0; a < Dim; ++a) out[a] = static_cast<Real>(v[static_cast<std::size_t>(a)]);
+  return out;
+}
+
+template <int Dim>
+std::vector<double> filled(double x) {
+  return std::vector<double>(static_cast<std::size_t>(Dim), x);
+}
+
+// An axis-aligned box read from "min"/"max"; max must exceed min on every axis.
+template <int Dim>
+struct Aabb {
+  std::vector<double> lo, hi;
+};
+
+template <int Dim>
+Aabb<Dim> read_box(JsonReader& r) {
+  Aabb<Dim> b{r.required_vector("min", Dim), r.required_vector("max", Dim)};
+  for (int a = 0; a < Dim; ++a)
+    if (!(b.hi[static_cast<std::size_t>(a)] > b.lo[static_cast<std::size_t>(a)]))
+      r.fail("max", "must exceed min on every axis (axis " + std::to_string(a) + ": max " +
+                        std::to_string(b.hi[static_cast<std::size_t>(a)]) + " <= min " +
+                        std::to_string(b.lo[static_cast<std::size_t>(a)]) + ")");
+  return b;
+}
+
+template <int Dim>
+bool overlap(const Aabb<Dim>& a, const Aabb<Dim>& b, double tol) {
+  for (std::size_t k = 0; k < Dim; ++k)
+    if (a.hi[k] <= b.lo[k] + tol || b.hi[k] <= a.lo[k] + tol) return false;
+  return true;
+}
+
+template <int Dim>
+bool inside(const Aabb<Dim>& inner, const Aabb<Dim>& outer, double tol) {
+  for (std::size_t k = 0; k < Dim; ++k)
+    if (inner.lo[k] < outer.lo[k] - tol || inner.hi[k] > outer.hi[k] + tol) return false;
+  return true;
+}
+
+// Number of lattice cells of `spacing` along each axis of a block.
+template <int Dim>
+std::array<long, 3> cells_of(const Aabb<Dim>& b, double spacing) {
+  std::array<long, 3> n{1, 1, 1};
+  for (std::size_t a = 0; a < Dim; ++a) n[a] = std::lround((b.hi[a] - b.lo[a]) / spacing);
+  return n;
+}
+
+}  // namespace
+
+template <int Dim, class Real>
+Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) {
+  Scene<Dim, Real> s;
+  s.header = read_scene_header(j, source);
+  s.source = source;
+  CELLSPH_CHECK(s.header.dim == Dim, "scene dimension " << s.header.dim << " loaded as " << Dim);
+  JsonReader r(j, source, "");
+  // The header keys were checked by read_scene_header; mark them read here.
+  r.string("name", "");
+  r.string("description", "");
+  r.integer("dimension", 2, 2, 3);
+  r.string("precision", "");
+
+  const double spacing = r.required_number("spacing", 1e-9, 1e9);
+  s.spacing = static_cast<Real>(spacing);
+  auto& cfg = s.solver;
+
+  // --- phases ---------------------------------------------------------------------------------
+  std::vector<std::string> phase_names;
+  if (r.has("phases")) {
+    cfg.phases.clear();
+    auto pr = r.child("phases");
+    const std::size_t np = pr.array_size();
+    if (np == 0) pr.fail_here("at least one phase is needed");
+    for (std::size_t k = 0; k < np; ++k) {
+      auto e = pr.element(k);
+      if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+      Phase<Real> ph;
+      ph.name = e.string("name", "phase" + std::to_string(k));
+      ph.rest_density = static_cast<Real>(e.number("rest_density", 1000, 1e-6, 1e9));
+      ph.mass = static_cast<Real>(e.number("mass", 0, 0, 1e12));
+      ph.viscosity = static_cast<Real>(e.number("viscosity", 0, 0, 1e9));
+      ph.color = static_cast<Real>(e.number("color", 1, -1e9, 1e9));
+      ph.sigma = static_cast<Real>(e.number("sigma", 0, 0, 1e9));
+      e.finish();
+      if (ph.mass == 0) ph.mass = ph.rest_density * static_cast<Real>(std::pow(spacing, Dim));
+      phase_names.push_back(ph.name);
+      cfg.phases.push_back(ph);
+    }
+  } else {
+    cfg.phases[0].mass = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
+    phase_names.push_back(cfg.phases[0].name);
+  }
+  auto read_phase = [&](JsonReader& e) -> std::int32_t {
+    if (!e.has("phase")) return 0;
+    const auto& v = e.json()["phase"];
+    if (v.is_string()) {
+      const std::string name = e.string("phase", "");
+      for (std::size_t k = 0; k < phase_names.size(); ++k)
+        if (phase_names[k] == name) return static_cast<std::int32_t>(k);
+      e.fail("phase", "no phase named \"" + name + "\"");
+    }
+    return static_cast<std::int32_t>(e.integer("phase", 0, 0, static_cast<long>(phase_names.size()) - 1));
+  };
+
+  // --- solver ---------------------------------------------------------------------------------
+  cfg.support = static_cast<Real>(2 * spacing);
+  if (r.has("solver")) {
+    auto sr = r.child("solver");
+    cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph"}));
+    cfg.support = static_cast<Real>(sr.number("support", 2 * spacing, 1e-9, 1e9));
+    if (cfg.support < static_cast<Real>(spacing))
+      sr.fail("support", "value " + std::to_string(cfg.support) + " is smaller than the particle spacing " +
+                             std::to_string(spacing) + ": particles would have no neighbours");
+    std::vector<std::string> kernels;
+    for (KernelKind k : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity, KernelKind::CubicSpline,
+                         KernelKind::WendlandC2})
+      kernels.emplace_back(kernel_name(k));
+    cfg.density_kernel = *parse_kernel(sr.choice("density_kernel", "poly6", kernels));
+    cfg.pressure_kernel = *parse_kernel(sr.choice("pressure_kernel", "spiky", kernels));
+    cfg.density = *parse_density_formulation(sr.choice("density", "mass", {"mass", "number"}));
+    if (sr.has("eos")) {
+      auto er = sr.child("eos");
+      cfg.eos.kind = *parse_eos(er.choice("kind", "tait", {"tait", "linear", "ratio", "seventh"}));
+      cfg.eos.stiffness = static_cast<Real>(er.number("stiffness", double(cfg.eos.stiffness), 1e-12, 1e15));
+      cfg.eos.gamma = static_cast<Real>(er.number("gamma", double(cfg.eos.gamma), 1e-3, 100));
+      cfg.eos.clamp_negative = er.boolean("clamp_negative", cfg.eos.clamp_negative);
+      er.finish();
+    }
+    if (sr.has("gravity")) cfg.gravity = to_vec<Dim, Real>(sr.vector("gravity", Dim, {}));
+    cfg.tension_threshold = static_cast<Real>(sr.number("tension_threshold", 0, 0, 1e12));
+    cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
+    cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
+    sr.finish();
+  } else {
+    cfg.model = Model::Wcsph;
+  }
+
+  // --- time -----------------------------------------------------------------------------------
+  if (r.has("time")) {
+    auto tr = r.child("time");
+    s.output.end_time = tr.number("end", s.output.end_time, 1e-12, 1e9);
+    cfg.time.mode = *parse_time_stepping(tr.choice("stepping", "courant", {"fixed", "courant"}));
+    cfg.time.dt = static_cast<Real>(tr.number("dt", double(cfg.time.dt), 1e-12, 10));
+    cfg.time.dt_max = static_cast<Real>(tr.number("dt_max", double(cfg.time.dt_max), 1e-12, 10));
+    cfg.time.courant = static_cast<Real>(tr.number("courant", double(cfg.time.courant), 1e-6, 2));
+    cfg.time.viscous = static_cast<Real>(tr.number("viscous", double(cfg.time.viscous), 1e-6, 10));
+    cfg.time.force = static_cast<Real>(tr.number("force", double(cfg.time.force), 1e-6, 10));
+    tr.finish();
+  } else {
+    cfg.time.mode = TimeStepping::Courant;
+  }
+
+  // --- neighbour search -----------------------------------------------------------------------
+  if (r.has("neighbors")) {
+    auto nr = r.child("neighbors");
+    std::vector<std::string> methods;
+    for (Method m : kAllMethods) methods.emplace_back(method_name(m));
+    cfg.search.method = *parse_method(nr.choice("method", "cell-index", methods));
+    cfg.search.subdivision = static_cast<int>(nr.integer("subdivision", 1, 1, 16));
+    cfg.search.hash_table_size = static_cast<std::size_t>(nr.integer("hash_table_size", 0, 0, 1L << 40));
+    nr.finish();
+  }
+
+  // --- boundary -------------------------------------------------------------------------------
+  std::vector<Aabb<Dim>> solids;                 // regions fluid must not overlap
+  std::optional<Aabb<Dim>> container;            // region fluid must lie in
+  auto& p = s.particles;
+  if (r.has("boundary")) {
+    auto br = r.child("boundary");
+    if (br.has("box")) {
+      auto bx = br.child("box");
+      const auto b = read_box<Dim>(bx);
+      cfg.box.enabled = true;
+      cfg.box.lo = to_vec<Dim, Real>(b.lo);
+      cfg.box.hi = to_vec<Dim, Real>(b.hi);
+      cfg.box.damping = static_cast<Real>(bx.number("damping", double(cfg.box.damping), -1, 0));
+      cfg.box.radius = static_cast<Real>(bx.number("radius", spacing / 2, 0, 1e9));
+      bx.finish();
+      container = b;
+    }
+    if (br.has("planes")) {
+      auto pl = br.child("planes");
+      for (std::size_t k = 0; k < pl.array_size(); ++k) {
+        auto e = pl.element(k);
+        auto n = e.required_vector("normal", Dim);
+        const auto pt = e.required_vector("point", Dim);
+        double len = 0;
+        for (double c : n) len += c * c;
+        len = std::sqrt(len);
+        if (!(len > 0)) e.fail("normal", "must not be the zero vector");
+        Plane<Dim, Real> plane;
+        double off = 0;
+        for (int a = 0; a < Dim; ++a) {
+          plane.normal[a] = static_cast<Real>(n[static_cast<std::size_t>(a)] / len);
+          off += n[static_cast<std::size_t>(a)] / len * pt[static_cast<std::size_t>(a)];
+        }
+        plane.offset = static_cast<Real>(off);
+        cfg.planes.push_back(plane);
+        e.finish();
+      }
+    }
+    if (br.has("walls")) {
+      auto wr = br.child("walls");
+      const auto b = read_box<Dim>(wr);
+      const int layers = static_cast<int>(wr.integer("layers", 3, 1, 10));
+      const bool open_top = wr.boolean("open_top", true);
+      wr.finish();
+      add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
+                    open_top);
+      container = b;
+    }
+    if (br.has("obstacles")) {
+      auto ob = br.child("obstacles");
+      for (std::size_t k = 0; k < ob.array_size(); ++k) {
+        auto e = ob.element(k);
+        const auto b = read_box<Dim>(e);
+        e.finish();
+        const auto n = cells_of<Dim>(b, spacing);
+        for (std::size_t a = 0; a < Dim; ++a)
+          if (n[a] < 1) e.fail("max", "obstacle is thinner than one particle spacing");
+        // A solid block of static boundary particles.
+        for (long kk = 0; kk < n[2]; ++kk)
+          for (long jj = 0; jj < n[1]; ++jj)
+            for (long ii = 0; ii < n[0]; ++ii) {
+              const long idx[3] = {ii, jj, kk};
+              Vec<Dim, Real> x;
+              for (std::size_t a = 0; a < Dim; ++a)
+                x[static_cast<int>(a)] = static_cast<Real>(b.lo[a] + (double(idx[a]) + 0.5) * spacing);
+              add_particle(p, x, 0, ParticleKind::Boundary);
+            }
+        solids.push_back(b);
+      }
+    }
+    br.finish();
+  }
+  if (r.has("domain")) {
+    auto dr = r.child("domain");
+    const auto b = read_box<Dim>(dr);
+    dr.finish();
+    cfg.domain_set = true;
+    cfg.domain_lo = to_vec<Dim, Real>(b.lo);
+    cfg.domain_hi = to_vec<Dim, Real>(b.hi);
+    if (!container) container = b;
+  }
+
+  // --- fluid blocks ---------------------------------------------------------------------------
+  if (!r.has("fluids")) r.fail("fluids", "missing (a list of fluid blocks is required)");
+  auto fr = r.child("fluids");
+  const std::size_t nf = fr.array_size();
+  if (nf == 0) fr.fail_here("at least one fluid block is needed");
+  std::vector<Aabb<Dim>> blocks;
+  const double tol = 1e-9 * spacing;
+  for (std::size_t k = 0; k < nf; ++k) {
+    auto e = fr.element(k);
+    if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+    const auto b = read_box<Dim>(e);
+    const std::int32_t phase = read_phase(e);
+    const auto vel = to_vec<Dim, Real>(e.vector("velocity", Dim, filled<Dim>(0)));
+    e.finish();
+    const auto n = cells_of<Dim>(b, spacing);
+    for (std::size_t a = 0; a < Dim; ++a)
+      if (n[a] < 1)
+        e.fail("max", "block holds no particle along axis " + std::to_string(a) + " (extent " +
+                          std::to_string(b.hi[a] - b.lo[a]) + " < spacing " + std::to_string(spacing) + ")");
+    for (std::size_t o = 0; o < blocks.size(); ++o)
+      if (overlap<Dim>(b, blocks[o], tol))
+        e.fail_here("overlaps fluid block " + std::to_string(o) + " (particles would sit on top of each other)");
+    for (std::size_t o = 0; o < solids.size(); ++o)
+      if (overlap<Dim>(b, solids[o], tol))
+        e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
+    if (container && !inside<Dim>(b, *container, tol))
+      e.fail_here("lies (partly) outside the boundary box");
+    blocks.push_back(b);
+    const std::size_t first = p.size();
+    add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
+    for (std::size_t i = first; i < p.size(); ++i) p.v[i] = vel;
+    if (p.size() > (std::size_t{1} << 31)) e.fail_here("more than 2^31 particles");
+  }
+
+  // --- output ---------------------------------------------------------------------------------
+  if (r.has("output")) {
+    auto orr = r.child("output");
+    s.output.fps = orr.number("fps", s.output.fps, 1e-6, 1e6);
+    if (orr.has("formats")) {
+      const auto& fj = orr.json()["formats"];
+      if (!fj.is_array()) orr.fail("formats", "expected an array of vtu, ply, csv, got " + json_value_text(fj));
+      auto list = orr.child("formats");
+      s.output.formats.clear();
+      for (std::size_t k = 0; k < list.array_size(); ++k) {
+        const auto& v = fj[k];
+        if (!v.is_string() || (v != "vtu" && v != "ply" && v != "csv"))
+          list.element(k).fail_here("unknown format " + json_value_text(v) + " (expected vtu, ply or csv)");
+        s.output.formats.push_back(v.get<std::string>());
+      }
+    }
+    s.output.checkpoint_every = static_cast<int>(orr.integer("checkpoint_every", s.output.checkpoint_every, 0, 1000000));
+    s.output.color_by = orr.choice("color_by", s.output.color_by, {"phase", "speed", "pressure"});
+    s.output.up_axis = static_cast<int>(orr.integer("up_axis", Dim - 1, 0, Dim - 1));
+    orr.finish();
+  } else {
+    s.output.up_axis = Dim - 1;
+  }
+  r.finish();
+
+  // The box drawn in pictures: the container, else the particles' bounds.
+  std::array<double, 3> lo{0, 0, 0}, hi{0, 0, 0};
+  if (container) {
+    for (std::size_t a = 0; a < Dim; ++a) {
+      lo[a] = container->lo[a];
+      hi[a] = container->hi[a];
+    }
+  } else {
+    for (std::size_t a = 0; a < Dim; ++a) {
+      lo[a] = std::numeric_limits<double>::max();
+      hi[a] = std::numeric_limits<double>::lowest();
+    }
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (std::size_t a = 0; a < Dim; ++a) {
+        lo[a] = std::min(lo[a], double(p.x[i][static_cast<int>(a)]));
+        hi[a] = std::max(hi[a], double(p.x[i][static_cast<int>(a)]));
+      }
+  }
+  s.view_lo = lo;
+  s.view_hi = hi;
+
+  try {
+    cfg.validate();
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return s;
+}
+
+template Scene<2, float> load_scene<2, float>(const nlohmann::json&, const std::string&);
+template Scene<2, double> load_scene<2, double>(const nlohmann::json&, const std::string&);
+template Scene<3, float> load_scene<3, float>(const nlohmann::json&, const std::string&);
+template Scene<3, double> load_scene<3, double>(const nlohmann::json&, const std::string&);
+
+}  // namespace cellsph

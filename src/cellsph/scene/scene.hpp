@@ -1,0 +1,61 @@
+#pragma once
+// Scenes: what a user edits. A scene file (JSON, documented key by key in docs/scenes.md) describes
+// the fluid blocks, walls and obstacles, the phases, the solver, time stepping, neighbour search and
+// output. load_scene() validates everything before anything runs and turns it into initial particles
+// and a SolverConfig; every error names the file, the key path and the value (InputError, exit 2).
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cellsph/solver/config.hpp"
+#include "cellsph/solver/particles.hpp"
+
+namespace cellsph {
+
+// What must be known before the scene can be instantiated for a dimension and precision.
+struct SceneHeader {
+  std::string name;
+  std::string description;
+  int dim = 2;
+  bool single_precision = false;  // "precision": "float"
+};
+
+// Output settings of a scene (command-line options override them).
+struct OutputSettings {
+  double end_time = 1.0;  // [s]
+  double fps = 30;        // frames per simulated second
+  std::vector<std::string> formats{"vtu"};  // any of vtu, ply, csv
+  int checkpoint_every = 10;                // frames between checkpoints; 0 = none
+  std::string color_by = "phase";           // phase | speed | pressure
+  int up_axis = 1;                          // world axis shown upwards in pictures
+};
+
+template <int Dim, class Real>
+struct Scene {
+  SceneHeader header;
+  std::string source;  // file name or "built-in scene NAME", for messages
+  Real spacing = 0;    // particle spacing [m]
+  SolverConfig<Dim, Real> solver;
+  Particles<Dim, Real> particles;  // initial fluid and boundary particles
+  OutputSettings output;
+  std::array<double, 3> view_lo{}, view_hi{};  // the box drawn in pictures
+};
+
+// A scene's JSON text: `name_or_path` is a built-in scene name or a path to a .json file. `source`
+// receives a label for error messages.
+nlohmann::json read_scene_json(const std::string& name_or_path, std::string& source);
+
+SceneHeader read_scene_header(const nlohmann::json& j, const std::string& source);
+
+template <int Dim, class Real>
+Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source);
+
+extern template Scene<2, float> load_scene<2, float>(const nlohmann::json&, const std::string&);
+extern template Scene<2, double> load_scene<2, double>(const nlohmann::json&, const std::string&);
+extern template Scene<3, float> load_scene<3, float>(const nlohmann::json&, const std::string&);
+extern template Scene<3, double> load_scene<3, double>(const nlohmann::json&, const std::string&);
+
+}  // namespace cellsph
