@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cellsph/core/error.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/particles.hpp"
 

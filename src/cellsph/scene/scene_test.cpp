@@ -1,0 +1,139 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/scene/scene.hpp"
+
+namespace cellsph {
+namespace {
+
+const char* kMinimal = R"({
+  "name": "t", "dimension": 2, "spacing": 0.1,
+  "fluids": [{"min": [0, 0], "max": [1, 0.5]}],
+  "boundary": {"box": {"min": [0, 0], "max": [2, 2]}}
+})";
+
+nlohmann::json with(const char* base, const std::string& pointer, const nlohmann::json& value) {
+  auto j = nlohmann::json::parse(base);
+  j[nlohmann::json::json_pointer(pointer)] = value;
+  return j;
+}
+
+// Loads and returns the error message ("" when the scene is valid).
+std::string load_error(const nlohmann::json& j) {
+  try {
+    const auto h = read_scene_header(j, "scene.json");
+    if (h.dim == 2)
+      load_scene<2, double>(j, "scene.json");
+    else
+      load_scene<3, double>(j, "scene.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scene, EveryBuiltinSceneLoads) {
+  ASSERT_FALSE(builtin_scenes().empty());
+  for (const auto& s : builtin_scenes()) {
+    std::string src;
+    const auto j = read_scene_json(std::string(s.name), src);
+    EXPECT_EQ(load_error(j), "") << s.name;
+    const auto h = read_scene_header(j, src);
+    EXPECT_EQ(h.name, s.name) << "a built-in scene's name must match its file name";
+    EXPECT_FALSE(h.description.empty()) << s.name;
+  }
+}
+
+TEST(Scene, BlockIsFilledAtLatticeCentresWithPhaseMass) {
+  const auto j = nlohmann::json::parse(kMinimal);
+  const auto s = load_scene<2, double>(j, "scene.json");
+  // 10 x 5 particles at cell centres of a 0.1 lattice.
+  ASSERT_EQ(s.particles.size(), 50u);
+  EXPECT_DOUBLE_EQ(s.particles.x[0][0], 0.05);
+  EXPECT_DOUBLE_EQ(s.particles.x[0][1], 0.05);
+  EXPECT_NEAR(s.solver.phases[0].mass, 1000 * 0.1 * 0.1, 1e-12);  // rest density x spacing^2
+  EXPECT_NEAR(s.solver.support, 0.2, 1e-15);                        // default: 2 spacings
+  EXPECT_TRUE(s.solver.box.enabled);
+}
+
+TEST(Scene, PlanesAreNormalisedAndPassThroughTheirPoint) {
+  auto j = nlohmann::json::parse(kMinimal);
+  j["boundary"]["planes"] = nlohmann::json::parse(R"([{"normal": [0, 2], "point": [0, 0.25]}])");
+  const auto s = load_scene<2, double>(j, "scene.json");
+  ASSERT_EQ(s.solver.planes.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.solver.planes[0].normal[1], 1.0);
+  EXPECT_DOUBLE_EQ(s.solver.planes[0].offset, 0.25);
+}
+
+struct BadCase {
+  const char* pointer;
+  const char* value;
+  const char* expect_path;  // the key path the message must name
+  const char* expect_text;  // and a word of the reason / the value
+};
+
+class SceneErrors : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(SceneErrors, NameFileKeyPathAndValue) {
+  const auto& c = GetParam();
+  const auto j = with(kMinimal, c.pointer, nlohmann::json::parse(c.value));
+  const std::string msg = load_error(j);
+  ASSERT_FALSE(msg.empty()) << "scene with " << c.pointer << " = " << c.value << " was accepted";
+  EXPECT_NE(msg.find("scene.json"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(c.expect_path), std::string::npos) << msg;
+  EXPECT_NE(msg.find(c.expect_text), std::string::npos) << msg;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scene, SceneErrors,
+    ::testing::Values(BadCase{"/spacng", "0.1", "/spacng", "unknown key"},
+                      BadCase{"/spacing", "\"big\"", "/spacing", "\"big\""},
+                      BadCase{"/spacing", "-1", "/spacing", "out of range"},
+                      BadCase{"/dimension", "4", "/dimension", "out of range"},
+                      BadCase{"/precision", "\"half\"", "/precision", "half"},
+                      BadCase{"/fluids/0/max", "[1]", "/fluids/0/max", "array of 2"},
+                      BadCase{"/fluids/0/max", "[0.04, 0.5]", "/fluids/0/max", "no particle"},
+                      BadCase{"/fluids/0/min", "[1, 0]", "/fluids/0/max", "must exceed min"},
+                      BadCase{"/fluids/1", R"({"min": [0.5, 0], "max": [1.5, 0.5]})", "/fluids/1",
+                              "overlaps fluid block 0"},
+                      BadCase{"/fluids/0/phase", "3", "/fluids/0/phase", "out of range"},
+                      BadCase{"/fluids/0/phase", "\"oil\"", "/fluids/0/phase", "oil"},
+                      BadCase{"/fluids/0/max", "[3, 0.5]", "/fluids/0", "outside the boundary box"},
+                      BadCase{"/solver/support", "0.05", "/solver/support", "smaller than the particle spacing"},
+                      BadCase{"/solver/model", "\"pbf\"", "/solver/model", "pbf"},
+                      BadCase{"/solver/eos/kind", "\"ideal\"", "/solver/eos/kind", "ideal"},
+                      BadCase{"/solver/gravity", "[0, \"down\"]", "/solver/gravity", "down"},
+                      BadCase{"/neighbors/method", "\"octree\"", "/neighbors/method", "octree"},
+                      BadCase{"/neighbors/subdivision", "0", "/neighbors/subdivision", "out of range"},
+                      BadCase{"/time/dt", "0", "/time/dt", "out of range"},
+                      BadCase{"/output/formats", "[\"obj\"]", "/output/formats/0", "obj"},
+                      BadCase{"/boundary/box/damping", "0.5", "/boundary/box/damping", "out of range"},
+                      BadCase{"/phases", "[]", "/phases", "at least one phase"},
+                      BadCase{"/phases/0", R"({"rest_density": -5})", "/phases/0/rest_density", "-5"}));
+
+TEST(Scene, MissingFileIsAnInputError) {
+  std::string src;
+  EXPECT_THROW(read_scene_json("/nonexistent/scene.json", src), InputError);
+}
+
+TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
+  const auto path = std::filesystem::temp_directory_path() / "cellsph_scene_syntax.json";
+  {
+    std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 0.1,,\n}\n";
+  }
+  std::string src;
+  try {
+    read_scene_json(path.string(), src);
+    FAIL() << "invalid JSON accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string() + ":3:"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace cellsph
