@@ -297,6 +297,22 @@ INSTANTIATE_TEST_SUITE_P(Methods, NeighborsCli,
                            return s;
                          });
 
+// The contract's default method is cell-index. (Until Cell Indexing is merged, the placeholder's
+// "CellIndex is not implemented yet" is itself the evidence of which method was chosen.)
+TEST(NeighborsCliInput, DefaultMethodIsCellIndex) {
+  TempDir dir;
+  write_file(dir / "in.csv", "x,y\n0,0\n0.5,0\n");
+  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") + " --radius 1 --stats --output " +
+                                  q(dir / "out.csv"));
+  if (r.code == 1) {
+    EXPECT_NE(r.err.find("CellIndex is not implemented yet"), std::string::npos) << r.err;
+  } else {
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.rfind("method=cell-index ", 0), 0u) << r.err;
+    EXPECT_EQ(read_file(dir / "out.csv"), "i,j\n0,1\n1,0\n");
+  }
+}
+
 // Columns in any order, extra columns, surrounding spaces, CRLF line ends, a leading '+'.
 TEST(NeighborsCliInput, ToleratesLayoutVariations) {
   TempDir dir;
