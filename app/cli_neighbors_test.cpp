@@ -74,8 +74,8 @@ struct RunResult {
 // Runs the built cellsph with `args` (already shell-quoted where needed).
 RunResult run_cli(const TempDir& dir, const std::string& args) {
   const fs::path out = dir.path() / "..stdout", err = dir.path() / "..stderr";
-  const std::string cmd = std::string("'") + CELLSPH_BINARY + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "'";
+  const std::string cmd =
+      std::string("'") + CELLSPH_BINARY + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   RunResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -208,11 +208,11 @@ struct MethodCase {
 
 class NeighborsCli : public ::testing::TestWithParam<MethodCase> {};
 
-#define SKIP_IF_METHOD_MISSING(r)                                                  \
-  do {                                                                             \
-    if ((r).code == 1 && (r).err.find("not implemented yet") != std::string::npos) { \
+#define SKIP_IF_METHOD_MISSING(r)                                                             \
+  do {                                                                                        \
+    if ((r).code == 1 && (r).err.find("not implemented yet") != std::string::npos) {          \
       GTEST_SKIP() << "method " << GetParam().method << " is not in this build: " << (r).err; \
-    }                                                                              \
+    }                                                                                         \
   } while (false)
 
 TEST_P(NeighborsCli, PairsMatchBruteForce) {
@@ -271,9 +271,10 @@ TEST_P(NeighborsCli, StatsLineReportsTheSearch) {
   ASSERT_EQ(r.code, 0) << r.err;
   std::size_t pairs = 0;
   for (const auto& row : brute_force(c, 0.8)) pairs += row.size();
-  const std::regex line("method=" + GetParam().method +
-                        " build_ms=[0-9]+\\.[0-9]+ query_ms=[0-9]+\\.[0-9]+ pairs=([0-9]+) candidates=([0-9]+) "
-                        "memory_bytes=([0-9]+)\n");
+  const std::regex line(
+      "method=" + GetParam().method +
+      " build_ms=[0-9]+\\.[0-9]+ query_ms=[0-9]+\\.[0-9]+ pairs=([0-9]+) candidates=([0-9]+) "
+      "memory_bytes=([0-9]+)\n");
   std::smatch m;
   ASSERT_TRUE(std::regex_match(r.err, m, line)) << r.err;
   EXPECT_EQ(std::stoull(m[1].str()), pairs);
@@ -302,8 +303,8 @@ INSTANTIATE_TEST_SUITE_P(Methods, NeighborsCli,
 TEST(NeighborsCliInput, DefaultMethodIsCellIndex) {
   TempDir dir;
   write_file(dir / "in.csv", "x,y\n0,0\n0.5,0\n");
-  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") + " --radius 1 --stats --output " +
-                                  q(dir / "out.csv"));
+  const auto r = run_cli(
+      dir, "neighbors --input " + q(dir / "in.csv") + " --radius 1 --stats --output " + q(dir / "out.csv"));
   if (r.code == 1) {
     EXPECT_NE(r.err.find("CellIndex is not implemented yet"), std::string::npos) << r.err;
   } else {
@@ -321,8 +322,8 @@ TEST(NeighborsCliInput, ToleratesLayoutVariations) {
              "a, 0 ,p, 0\r\n"
              "b,+1,q,0\r\n"
              "c,  2.5e0,r,0.0\r\n");
-  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") + " --radius 1.5 --method all-pairs --output " +
-                                  q(dir / "out.csv"));
+  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
+                                  " --radius 1.5 --method all-pairs --output " + q(dir / "out.csv"));
   ASSERT_EQ(r.code, 0) << r.err;
   // Points (0,0), (0,1), (0,2.5): 0-1 at distance 1, 1-2 at 1.5 (boundary counts), 0-2 at 2.5.
   EXPECT_EQ(read_file(dir / "out.csv"), "i,j\n0,1\n1,0\n1,2\n2,1\n");
@@ -332,8 +333,8 @@ TEST(NeighborsCliInput, ExistingOutputIsReplacedAtomically) {
   TempDir dir;
   write_file(dir / "in.csv", "x,y\n0,0\n0.5,0\n");
   write_file(dir / "out.csv", "old contents\n");
-  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") + " --radius 1 --method all-pairs --output " +
-                                  q(dir / "out.csv"));
+  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
+                                  " --radius 1 --method all-pairs --output " + q(dir / "out.csv"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(read_file(dir / "out.csv"), "i,j\n0,1\n1,0\n");
   EXPECT_EQ(dir.listing(), (std::vector<std::string>{"in.csv", "out.csv"}));
@@ -343,8 +344,8 @@ TEST(NeighborsCliInput, ExistingOutputIsReplacedAtomically) {
 // Bad input: exit code 2, exactly one line on stderr holding every expected fragment, no output.
 struct BadCase {
   std::string name;
-  std::string file;       // contents of in.csv ("<none>": do not create it)
-  std::string options;    // after --input in.csv
+  std::string file;     // contents of in.csv ("<none>": do not create it)
+  std::string options;  // after --input in.csv
   std::vector<std::string> mentions;
 };
 
@@ -364,12 +365,13 @@ TEST_P(NeighborsCliBadInput, ExitsTwoWithOneLineAndNoOutput) {
       files.push_back("out.csv");
       std::sort(files.begin(), files.end());
     }
-    const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") + " " + b.options + " --output " +
-                                    q(dir / "out.csv"));
+    const auto r = run_cli(
+        dir, "neighbors --input " + q(dir / "in.csv") + " " + b.options + " --output " + q(dir / "out.csv"));
     EXPECT_EQ(r.code, 2) << r.err;
     ASSERT_FALSE(r.err.empty());
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
-    for (const auto& m : b.mentions) EXPECT_NE(r.err.find(m), std::string::npos) << "no '" << m << "' in: " << r.err;
+    for (const auto& m : b.mentions)
+      EXPECT_NE(r.err.find(m), std::string::npos) << "no '" << m << "' in: " << r.err;
     EXPECT_EQ(r.out, "");
     // No output (or the previous output untouched), and no temporary file left behind.
     EXPECT_EQ(dir.listing(), files);
@@ -385,20 +387,26 @@ INSTANTIATE_TEST_SUITE_P(
     Errors, NeighborsCliBadInput,
     ::testing::Values(
         BadCase{"missing_column", "x,z,h\n1,2,3\n", "--radius 1", {"in.csv", "line 1", "missing column 'y'"}},
-        BadCase{"non_numeric", "x,y\n1,2\n3,abc\n", "--radius 1", {"in.csv", "line 3", "column 'y'", "'abc'"}},
-        BadCase{"trailing_junk", "x,y,z\n1,2,3\n4,5,6.0x\n", "--radius 1", {"in.csv", "line 3", "'z'", "'6.0x'"}},
+        BadCase{
+            "non_numeric", "x,y\n1,2\n3,abc\n", "--radius 1", {"in.csv", "line 3", "column 'y'", "'abc'"}},
+        BadCase{
+            "trailing_junk", "x,y,z\n1,2,3\n4,5,6.0x\n", "--radius 1", {"in.csv", "line 3", "'z'", "'6.0x'"}},
         BadCase{"empty_field", "x,y\n1,\n", "--radius 1", {"in.csv", "line 2", "'y'", "empty value"}},
         BadCase{"nan", "x,y\n1,2\nNaN,3\n", "--radius 1", {"in.csv", "line 3", "'x'", "'NaN'"}},
         BadCase{"infinite", "x,y,z\n1,2,inf\n", "--radius 1", {"in.csv", "line 2", "'z'", "'inf'"}},
         BadCase{"overflow", "x,y\n1e999,2\n", "--radius 1", {"in.csv", "line 2", "'x'", "'1e999'"}},
-        BadCase{"ragged_short", "x,y,z\n1,2,3\n1,2\n", "--radius 1", {"in.csv", "line 3", "2 field(s)", "header has 3"}},
+        BadCase{"ragged_short",
+                "x,y,z\n1,2,3\n1,2\n",
+                "--radius 1",
+                {"in.csv", "line 3", "2 field(s)", "header has 3"}},
         BadCase{"ragged_long", "x,y\n1,2,3\n", "--radius 1", {"in.csv", "line 2", "3 field(s)"}},
         BadCase{"blank_row_inside", "x,y\n1,2\n\n3,4\n", "--radius 1", {"in.csv", "line 3", "empty row"}},
         BadCase{"empty_file", "", "--radius 1", {"in.csv", "empty"}},
         BadCase{"blank_file", "\n \r\n", "--radius 1", {"in.csv", "empty"}},
         BadCase{"header_only", "x,y,z\n", "--radius 1", {"in.csv", "no data rows"}},
         BadCase{"unreadable", "<none>", "--radius 1", {"in.csv", "cannot read", "No such file"}},
-        BadCase{"duplicate_column", "x,y,x\n1,2,3\n", "--radius 1", {"in.csv", "line 1", "'x' appears twice"}},
+        BadCase{
+            "duplicate_column", "x,y,x\n1,2,3\n", "--radius 1", {"in.csv", "line 1", "'x' appears twice"}},
         BadCase{"h_zero", "x,y,h\n1,2,0.5\n3,4,0\n", "--radius 1", {"in.csv", "line 3", "'h'", "'0'"}},
         BadCase{"h_negative", "x,y,h\n1,2,-0.5\n", "", {"in.csv", "line 2", "'h'", "'-0.5'"}},
         BadCase{"radius_zero", kGood, "--radius 0", {"--radius", "'0'"}},
@@ -406,7 +414,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"radius_nan", kGood, "--radius nan", {"--radius", "'nan'"}},
         BadCase{"radius_text", kGood, "--radius abc", {"--radius", "'abc'"}},
         BadCase{"radius_missing", kGood, "", {"--radius", "in.csv", "'h'"}},
-        BadCase{"unknown_method", kGood, "--radius 1 --method octree", {"--method", "'octree'", "cell-index"}},
+        BadCase{
+            "unknown_method", kGood, "--radius 1 --method octree", {"--method", "'octree'", "cell-index"}},
         BadCase{"subdivision_zero", kGood, "--radius 1 --subdivision 0", {"--subdivision", "0"}},
         BadCase{"threads_zero", kGood, "--radius 1 --threads 0", {"--threads", "0"}},
         BadCase{"threads_negative", kGood, "--radius 1 --threads -3", {"--threads", "-3"}}),
@@ -415,7 +424,8 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(NeighborsCliInput, DirectoryAsInputIsUnreadable) {
   TempDir dir;
   fs::create_directory(dir / "sub");
-  const auto r = run_cli(dir, "neighbors --input " + q(dir / "sub") + " --radius 1 --output " + q(dir / "out.csv"));
+  const auto r =
+      run_cli(dir, "neighbors --input " + q(dir / "sub") + " --radius 1 --output " + q(dir / "out.csv"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("sub"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out.csv"));

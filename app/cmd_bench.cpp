@@ -81,8 +81,8 @@ std::vector<T> parse_list(const std::string& option, const std::string& text, T 
     T v{};
     const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
     if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !(v >= min_value))
-      throw InputError(option + ": '" + item + "' is not a number >= " + std::to_string(min_value) + " (in '" +
-                       text + "')");
+      throw InputError(option + ": '" + item + "' is not a number >= " + std::to_string(min_value) +
+                       " (in '" + text + "')");
     out.push_back(v);
     b = c + 1;
   }
@@ -102,7 +102,7 @@ std::vector<std::string> split(const std::string& text) {
 
 // ---- one measured run ------------------------------------------------------------------------------
 struct Row {
-  SearchStats stats;          // best build and query over the repetitions
+  SearchStats stats;  // best build and query over the repetitions
   std::uint64_t lists_bytes = 0;
   std::optional<std::uint64_t> peak_growth_bytes;
   std::uint64_t checksum = 0;
@@ -150,7 +150,9 @@ Row measure(const std::vector<Vec<Dim, double>>& x, double radius, const SearchO
   return row;
 }
 
-double mib(std::uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
+double mib(std::uint64_t bytes) {
+  return static_cast<double>(bytes) / (1024.0 * 1024.0);
+}
 
 void print_header() {
   std::printf("  %-13s %10s %10s %10s %12s %9s %10s %10s %10s %7s  %s\n", "method", "build ms", "query ms",
@@ -198,16 +200,17 @@ void bench_set(const std::string& title, const std::vector<Vec<Dim, double>>& x,
     }
     const double per_nbr =
         s.pairs > 0 ? static_cast<double>(s.candidates) / static_cast<double>(s.pairs) : 0.0;
-    std::printf("  %-13s %10.2f %10.2f %10.2f %12llu %9.2f %10.1f %10.1f %10s %7s  %s\n", name.c_str(), s.build_ms,
-                s.query_ms, s.build_ms + s.query_ms, static_cast<unsigned long long>(s.pairs), per_nbr,
-                mib(s.memory_bytes), mib(r.lists_bytes), peak, ratio, check.c_str());
+    std::printf("  %-13s %10.2f %10.2f %10.2f %12llu %9.2f %10.1f %10.1f %10s %7s  %s\n", name.c_str(),
+                s.build_ms, s.query_ms, s.build_ms + s.query_ms, static_cast<unsigned long long>(s.pairs),
+                per_nbr, mib(s.memory_bytes), mib(r.lists_bytes), peak, ratio, check.c_str());
     std::fflush(stdout);
   }
 }
 
 template <int Dim>
-void bench_neighbors(const BenchArgs& a, const std::vector<Method>& methods, const std::vector<std::size_t>& sizes,
-                     const std::vector<double>& radii, const std::vector<std::string>& sets) {
+void bench_neighbors(const BenchArgs& a, const std::vector<Method>& methods,
+                     const std::vector<std::size_t>& sizes, const std::vector<double>& radii,
+                     const std::vector<std::string>& sets) {
   if constexpr (Dim == 3) {
     const auto dam = point_sets::paper_dam_break<3, double>();
     bench_set<3>("dam-break (paper sec. 5): n=1600, 10x20x8 lattice, spacing 0.010627 m, h=0.05 m", dam,
@@ -258,17 +261,21 @@ void run_bench_neighbors(const BenchArgs& a) {
   for (const auto& set : sets)
     if (set != "lattice" && set != "uniform" && set != "clustered")
       throw InputError("--sets: unknown point set '" + set + "' (expected lattice,uniform,clustered)");
-  if (a.subdivision < 1) throw InputError("--subdivision: must be >= 1, got " + std::to_string(a.subdivision));
-  if (a.threads_given && a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
+  if (a.subdivision < 1)
+    throw InputError("--subdivision: must be >= 1, got " + std::to_string(a.subdivision));
+  if (a.threads_given && a.threads < 1)
+    throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
   if (a.repeat < 1) throw InputError("--repeat: must be >= 1, got " + std::to_string(a.repeat));
   if (a.dim != 2 && a.dim != 3) throw InputError("--dim: must be 2 or 3, got " + std::to_string(a.dim));
 
   ScopedThreads threads(a.threads_given ? a.threads : max_threads());
-  std::printf("cellsph bench neighbors: %dD, double, %d thread(s), subdivision H=%d, best of up to %d run(s)\n",
-              a.dim, max_threads(), a.subdivision, a.repeat);
-  std::printf("  times: build = structure, query = all CSR lists (NeighborSearch::find_all); cand/nbr = distance\n"
-              "  tests per neighbour found; stats = memory_bytes reported by the search; lists = CSR size;\n"
-              "  peak = growth of peak RSS (VmHWM) during build+query; peak/l = peak / lists size.\n");
+  std::printf(
+      "cellsph bench neighbors: %dD, double, %d thread(s), subdivision H=%d, best of up to %d run(s)\n",
+      a.dim, max_threads(), a.subdivision, a.repeat);
+  std::printf(
+      "  times: build = structure, query = all CSR lists (NeighborSearch::find_all); cand/nbr = distance\n"
+      "  tests per neighbour found; stats = memory_bytes reported by the search; lists = CSR size;\n"
+      "  peak = growth of peak RSS (VmHWM) during build+query; peak/l = peak / lists size.\n");
   std::fflush(stdout);
   if (a.dim == 2)
     bench_neighbors<2>(a, methods, sizes, radii, sets);
@@ -285,14 +292,17 @@ void register_bench(CLI::App& app, int& result) {
   auto args = std::make_shared<BenchArgs>();
   auto* nb = sub->add_subcommand("neighbors", "Neighbour search: every method on the paper's point sets");
   nb->add_option("--sizes", args->sizes, "comma-separated particle counts")->capture_default_str();
-  nb->add_option("--methods", args->methods, "comma-separated methods (default: all): " + method_names_joined(","));
+  nb->add_option("--methods", args->methods,
+                 "comma-separated methods (default: all): " + method_names_joined(","));
   nb->add_option("--radii", args->radii, "comma-separated radii in lattice spacings")->capture_default_str();
   nb->add_option("--sets", args->sets, "comma-separated point sets")->capture_default_str();
   auto* threads = nb->add_option("--threads", args->threads, "threads (default: all cores)");
   nb->add_option("--subdivision", args->subdivision, "subdivision factor H (cells of size h/H)")
       ->capture_default_str();
-  nb->add_option("--dim", args->dim, "dimension, 2 or 3 (the dam-break set is 3D only)")->capture_default_str();
-  nb->add_option("--repeat", args->repeat, "runs per measurement; the fastest is reported")->capture_default_str();
+  nb->add_option("--dim", args->dim, "dimension, 2 or 3 (the dam-break set is 3D only)")
+      ->capture_default_str();
+  nb->add_option("--repeat", args->repeat, "runs per measurement; the fastest is reported")
+      ->capture_default_str();
   nb->add_flag("--quick", args->quick, "small sizes only (3000 points), for tests and docs");
   nb->callback([args, threads, &result] {
     args->threads_given = threads->count() > 0;

@@ -92,7 +92,8 @@ void run(const NeighborsArgs& a, double radius, Method method, const PointsTable
   if (a.stats) {
     const SearchStats& s = ns.stats();
     char line[256];
-    std::snprintf(line, sizeof line, "method=%s build_ms=%.3f query_ms=%.3f pairs=%llu candidates=%llu memory_bytes=%llu\n",
+    std::snprintf(line, sizeof line,
+                  "method=%s build_ms=%.3f query_ms=%.3f pairs=%llu candidates=%llu memory_bytes=%llu\n",
                   std::string(method_name(method)).c_str(), s.build_ms, s.query_ms,
                   static_cast<unsigned long long>(s.pairs), static_cast<unsigned long long>(s.candidates),
                   static_cast<unsigned long long>(s.memory_bytes));
@@ -115,7 +116,8 @@ void run(const NeighborsArgs& a, double radius, Method method, const PointsTable
 void run_neighbors(const NeighborsArgs& a) {
   const auto method = parse_method(a.method);
   if (!method)
-    throw InputError("--method: unknown method '" + a.method + "' (expected one of " + method_names_joined() + ")");
+    throw InputError("--method: unknown method '" + a.method + "' (expected one of " + method_names_joined() +
+                     ")");
   if (a.subdivision < 1)
     throw InputError("--subdivision: must be an integer >= 1, got " + std::to_string(a.subdivision));
   if (a.threads_given && a.threads < 1)
@@ -148,9 +150,9 @@ void register_neighbors(CLI::App& app, int& result) {
   auto args = std::make_shared<NeighborsArgs>();
   auto* sub = app.add_subcommand("neighbors", "Find all neighbours of a point set (CSV in, CSV out)");
   sub->add_option("--input", args->input, "CSV with header x,y or x,y,z (optional h column)")->required();
-  auto* radius = sub->add_option("--radius", args->radius, "support length h (> 0); an 'h' column overrides it");
-  sub->add_option("--method", args->method, "search method: " + method_names_joined())
-      ->capture_default_str();
+  auto* radius =
+      sub->add_option("--radius", args->radius, "support length h (> 0); an 'h' column overrides it");
+  sub->add_option("--method", args->method, "search method: " + method_names_joined())->capture_default_str();
   sub->add_option("--subdivision", args->subdivision, "subdivision factor H: cells of size h/H (>= 1)")
       ->capture_default_str();
   auto* threads = sub->add_option("--threads", args->threads, "threads (>= 1; default: all cores)");

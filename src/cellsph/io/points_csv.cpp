@@ -53,9 +53,9 @@ std::string where(std::string_view source, std::size_t line) {
 
 struct Column {
   std::string_view name;
-  std::size_t index = 0;        // 0-based position in the header
+  std::size_t index = 0;  // 0-based position in the header
   std::vector<double>* target = nullptr;
-  bool positive = false;        // h must be > 0
+  bool positive = false;  // h must be > 0
 };
 
 // Strict number: the whole (trimmed) field, finite. std::from_chars does not accept a leading '+',
@@ -69,7 +69,8 @@ double parse_field(std::string_view raw, const Column& col, std::string_view sou
   if (v.empty()) fail("empty value");
   const char* first = v.data();
   const char* last = v.data() + v.size();
-  if (*first == '+' && v.size() > 1 && (std::isdigit(static_cast<unsigned char>(first[1])) || first[1] == '.'))
+  if (*first == '+' && v.size() > 1 &&
+      (std::isdigit(static_cast<unsigned char>(first[1])) || first[1] == '.'))
     ++first;
   double value = 0;
   const auto [ptr, ec] = std::from_chars(first, last, value, std::chars_format::general);
@@ -106,7 +107,8 @@ PointsTable parse_points_csv(std::string_view text, std::string_view source) {
   std::string_view header;
   next_line(header);
   if (trim(header).empty())
-    throw InputError(where(source, line_no) + ": expected the header row (x,y or x,y,z), found an empty line");
+    throw InputError(where(source, line_no) +
+                     ": expected the header row (x,y or x,y,z), found an empty line");
 
   PointsTable t;
   std::vector<std::string_view> names;
@@ -159,7 +161,8 @@ PointsTable parse_points_csv(std::string_view text, std::string_view source) {
       continue;
     }
     if (blank_line != 0)
-      throw InputError(where(source, blank_line) + ": empty row (every row after the header must hold a point)");
+      throw InputError(where(source, blank_line) +
+                       ": empty row (every row after the header must hold a point)");
     std::size_t field = 0;
     for (std::size_t b = 0;; ++field) {
       const auto c = line.find(',', b);
@@ -172,8 +175,8 @@ PointsTable parse_points_csv(std::string_view text, std::string_view source) {
       b = c + 1;
     }
     if (field + 1 != n_fields)
-      throw InputError(where(source, line_no) + ": row has " + std::to_string(field + 1) + " field(s), the header has " +
-                       std::to_string(n_fields) + ": " + shown(line));
+      throw InputError(where(source, line_no) + ": row has " + std::to_string(field + 1) +
+                       " field(s), the header has " + std::to_string(n_fields) + ": " + shown(line));
   }
   if (t.size() == 0)
     throw InputError("points file '" + std::string(source) + "' has a header but no data rows");
@@ -196,7 +199,8 @@ PointsTable read_points_csv(const std::filesystem::path& file) {
     const std::size_t got = std::fread(buf, 1, sizeof buf, f.get());
     text.append(buf, got);
     if (got < sizeof buf) {
-      if (std::ferror(f.get())) throw InputError("cannot read points file '" + name + "': " + std::strerror(errno));
+      if (std::ferror(f.get()))
+        throw InputError("cannot read points file '" + name + "': " + std::strerror(errno));
       break;
     }
   }

@@ -18,9 +18,9 @@
 namespace cellsph {
 
 struct PointsTable {
-  int dim = 0;                                 // 2 or 3
-  std::array<std::vector<double>, 3> coord;    // coord[k][i]: axis k of particle i (k < dim)
-  std::vector<double> h;                       // per-particle support; empty without an `h` column
+  int dim = 0;                               // 2 or 3
+  std::array<std::vector<double>, 3> coord;  // coord[k][i]: axis k of particle i (k < dim)
+  std::vector<double> h;                     // per-particle support; empty without an `h` column
   [[nodiscard]] std::size_t size() const { return coord[0].size(); }
   [[nodiscard]] bool has_h() const { return !h.empty(); }
 

@@ -31,9 +31,12 @@ double sample_in_cell(int cell, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double lo = cell, hi = std::nextafter(cell + 1.0, double(cell));
   switch (rng() % 4) {
-    case 0: return lo;
-    case 1: return hi;
-    default: return std::min(hi, lo + u(rng));
+    case 0:
+      return lo;
+    case 1:
+      return hi;
+    default:
+      return std::min(hi, lo + u(rng));
   }
 }
 
@@ -62,8 +65,8 @@ void check_never_misses(int H) {
     if (r2 > reach * reach) continue;
     ++within;
     hit.insert(cq);
-    ASSERT_TRUE(mask.count(cq)) << "H=" << H << " Dim=" << Dim << ": a neighbour at distance " << std::sqrt(r2)
-                                << " lies in a cell the mask leaves out";
+    ASSERT_TRUE(mask.count(cq)) << "H=" << H << " Dim=" << Dim << ": a neighbour at distance "
+                                << std::sqrt(r2) << " lies in a cell the mask leaves out";
   }
   EXPECT_GT(within, 1000u);
   // The mask is not needlessly large either: nearly every cell in it was seen holding a neighbour
@@ -155,8 +158,9 @@ TEST(HMaskEq16, MissesPairsWhereTheExactMaskMissesNone) {
   for (const auto& r : measure_eq16<2>(3600, 2.0)) rows.push_back(r);
   for (const auto& r : measure_eq16<3>(5832, 2.0)) rows.push_back(r);
   std::printf("jittered lattice (spacing s, jitter 0.01 s), h = 2 s; 2D: 60x60 points, 3D: 18^3 points\n");
-  std::printf("| dim | H | true pairs | eq. 16 missed | exact mask missed | cells eq. 16 | cells exact |"
-              " h'=h/(2H+1) missed | cells |\n|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| dim | H | true pairs | eq. 16 missed | exact mask missed | cells eq. 16 | cells exact |"
+      " h'=h/(2H+1) missed | cells |\n|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& r : rows) {
     const auto pct = [&](std::uint64_t m) { return 100.0 * double(m) / double(r.pairs); };
     std::printf("| %dD | %d | %llu | %.2f %% | %llu | %zu | %zu | %.1f %% | %zu |\n", r.dim, r.H,

@@ -68,7 +68,7 @@ std::vector<Vec<Dim, Real>> clustered(std::size_t n, Real s, int blobs = 8, std:
 // rho_0 = 1000 kg/m^3, mass m = 0.0012 kg and support length h = 0.05 m (kPaperDamBreakH). Density
 // and mass are volumetric, so the set is 3D with particle spacing (m / rho_0)^(1/3) = 0.010627 m;
 // the particles fill a column of 10 (x) by 20 (y, up) by 8 (z) lattice sites from the origin.
-// At that spacing h reaches about 4.7 spacings: an interior particle has ~430 neighbours.
+// At that spacing h reaches about 4.7 spacings: an interior particle has 460 neighbours.
 inline constexpr double kPaperDamBreakH = 0.05;
 inline constexpr int kPaperDamBreakBlock[3] = {10, 20, 8};
 
