@@ -215,6 +215,8 @@ void bench_neighbors(const BenchArgs& a, const std::vector<Method>& methods,
     const auto dam = point_sets::paper_dam_break<3, double>();
     bench_set<3>("dam-break (paper sec. 5): n=1600, 10x20x8 lattice, spacing 0.010627 m, h=0.05 m", dam,
                  point_sets::kPaperDamBreakH, methods, a);
+  } else {
+    std::printf("\n(dam-break set skipped: the paper's set is 3D)\n");
   }
   const double s = 1.0;  // lattice spacing; radii are given in units of it
   for (std::size_t n : sizes) {
