@@ -149,16 +149,19 @@ void run_neighbors(const NeighborsArgs& a) {
 void register_neighbors(CLI::App& app, int& result) {
   auto args = std::make_shared<NeighborsArgs>();
   auto* sub = app.add_subcommand("neighbors", "Find all neighbours of a point set (CSV in, CSV out)");
-  sub->add_option("--input", args->input, "CSV with header x,y or x,y,z (optional h column)")->required();
+  sub->add_option("--input", args->input, "CSV with header x,y or x,y,z (optional h column)")
+      ->required()
+      ->type_name("FILE");
   auto* radius =
-      sub->add_option("--radius", args->radius, "support length h (> 0); an 'h' column overrides it");
+      sub->add_option("--radius", args->radius, "support length h (> 0); an 'h' column overrides it")
+          ->type_name("R");
   sub->add_option("--method", args->method, "search method: " + method_names_joined())->capture_default_str();
   sub->add_option("--subdivision", args->subdivision, "subdivision factor H: cells of size h/H (>= 1)")
       ->capture_default_str();
   auto* threads = sub->add_option("--threads", args->threads, "threads (>= 1; default: all cores)");
   sub->add_flag("--counts", args->counts, "write i,count (neighbours per particle) instead of i,j pairs");
   sub->add_flag("--stats", args->stats, "print one line of search statistics to stderr");
-  sub->add_option("--output", args->output, "output CSV (written atomically)")->required();
+  sub->add_option("--output", args->output, "output CSV (written atomically)")->required()->type_name("FILE");
   sub->callback([args, radius, threads, &result] {
     args->radius_given = radius->count() > 0;
     args->threads_given = threads->count() > 0;
