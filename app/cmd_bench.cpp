@@ -1,9 +1,324 @@
-// `cellsph bench ...`: PLACEHOLDER, to be written.
+// `cellsph bench ...`: benchmarks printed as tables. `cellsph bench` alone lists them.
+//
+// `cellsph bench neighbors` follows the paper's Table 1 (build and query time per method), adding
+// what a fair comparison of exact methods needs: pairs found, distance tests per neighbour found
+// (the cost of a method's over-approximation), and memory: the bytes the search reports holding,
+// the neighbour lists' own size, and the growth of the process's peak resident set during
+// build + find_all, measured by the kernel (VmHWM after resetting it through /proc/self/clear_refs).
+#include <malloc.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/neighbors/neighbor_search.hpp"
+#include "cellsph/neighbors/point_sets.hpp"
 #include "commands.hpp"
 
 namespace cellsph::app {
-void register_bench(CLI::App& app, int& result) {
-  auto* sub = app.add_subcommand("bench", "Benchmarks");
-  sub->callback([&result] { result = 1; });
+
+namespace {
+
+constexpr std::size_t kAllPairsLimit = 20000;  // O(n^2): ~4e8 distance tests, a few seconds
+
+struct BenchArgs {
+  std::string sizes = "10000,100000,1000000";
+  std::string methods;
+  std::string radii = "2,4";
+  std::string sets = "lattice,uniform,clustered";
+  int threads = 0;
+  bool threads_given = false;
+  int subdivision = 1;
+  int dim = 3;
+  int repeat = 3;
+  bool quick = false;
+};
+
+// ---- memory of this process, from /proc (Linux) --------------------------------------------------
+std::optional<std::uint64_t> status_kb(const char* key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  const std::string k = std::string(key) + ":";
+  while (std::getline(f, line)) {
+    if (line.rfind(k, 0) != 0) continue;
+    std::uint64_t v = 0;
+    const auto b = line.find_first_of("0123456789");
+    if (b == std::string::npos) return std::nullopt;
+    std::from_chars(line.data() + b, line.data() + line.size(), v);
+    return v;
+  }
+  return std::nullopt;
 }
+
+// Resets the kernel's peak-RSS mark (VmHWM) to the current RSS. False where not permitted.
+bool reset_peak_rss() {
+  std::ofstream f("/proc/self/clear_refs");
+  f << "5";
+  f.flush();
+  return static_cast<bool>(f);
+}
+
+// ---- parsing of the list options ------------------------------------------------------------------
+template <class T>
+std::vector<T> parse_list(const std::string& option, const std::string& text, T min_value) {
+  std::vector<T> out;
+  std::size_t b = 0;
+  while (b <= text.size()) {
+    const auto c = std::min(text.find(',', b), text.size());
+    const std::string item = text.substr(b, c - b);
+    T v{};
+    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !(v >= min_value))
+      throw InputError(option + ": '" + item + "' is not a number >= " + std::to_string(min_value) +
+                       " (in '" + text + "')");
+    out.push_back(v);
+    b = c + 1;
+  }
+  return out;
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t b = 0;
+  while (b <= text.size()) {
+    const auto c = std::min(text.find(',', b), text.size());
+    out.push_back(text.substr(b, c - b));
+    b = c + 1;
+  }
+  return out;
+}
+
+// ---- one measured run ------------------------------------------------------------------------------
+struct Row {
+  SearchStats stats;  // best build and query over the repetitions
+  std::uint64_t lists_bytes = 0;
+  std::optional<std::uint64_t> peak_growth_bytes;
+  std::uint64_t checksum = 0;
+};
+
+// FNV-1a over the CSR lists: equal checksums across methods mean equal neighbour sets (rows are
+// sorted, so the lists are canonical).
+std::uint64_t checksum(const NeighborList& nl) {
+  std::uint64_t h = 1469598103934665603ULL;
+  auto mix = [&h](std::uint64_t v) {
+    h ^= v;
+    h *= 1099511628211ULL;
+  };
+  for (std::uint64_t o : nl.offsets) mix(o);
+  for (std::uint32_t j : nl.indices) mix(j);
+  return h;
+}
+
+template <int Dim>
+Row measure(const std::vector<Vec<Dim, double>>& x, double radius, const SearchOptions& opt, int repeat) {
+  Row row;
+  for (int rep = 0; rep < repeat; ++rep) {
+    NeighborSearch<Dim, double> ns(opt);
+    NeighborList nl;
+    // Give freed memory back first so the baseline is the live set, not the allocator's cache.
+    ::malloc_trim(0);
+    const auto rss0 = status_kb("VmRSS");
+    const bool reset = rss0 && reset_peak_rss();
+    ns.build(x, radius);
+    ns.find_all(nl);
+    const auto hwm = status_kb("VmHWM");
+    const SearchStats& s = ns.stats();
+    if (rep == 0) {
+      row.stats = s;
+      row.lists_bytes = nl.memory_bytes();
+      if (reset && hwm) row.peak_growth_bytes = (*hwm > *rss0 ? *hwm - *rss0 : 0) * 1024;
+      row.checksum = checksum(nl);
+    } else {
+      row.stats.build_ms = std::min(row.stats.build_ms, s.build_ms);
+      row.stats.query_ms = std::min(row.stats.query_ms, s.query_ms);
+    }
+    // Large sets: one run is long enough to be stable.
+    if (s.build_ms + s.query_ms > 2000) break;
+  }
+  return row;
+}
+
+double mib(std::uint64_t bytes) {
+  return static_cast<double>(bytes) / (1024.0 * 1024.0);
+}
+
+void print_header() {
+  std::printf("  %-13s %10s %10s %10s %12s %9s %10s %10s %10s %7s  %s\n", "method", "build ms", "query ms",
+              "total ms", "pairs", "cand/nbr", "stats MiB", "lists MiB", "peak MiB", "peak/l", "check");
+}
+
+template <int Dim>
+void bench_set(const std::string& title, const std::vector<Vec<Dim, double>>& x, double radius,
+               const std::vector<Method>& methods, const BenchArgs& a) {
+  std::printf("\n== %s ==\n", title.c_str());
+  print_header();
+  std::optional<std::uint64_t> reference;  // checksum of the first method that ran
+  std::string reference_name;
+  for (Method m : methods) {
+    const std::string name(method_name(m));
+    if (m == Method::AllPairs && x.size() > kAllPairsLimit) {
+      std::printf("  %-13s skipped: O(n^2) is only run up to n = %zu\n", name.c_str(), kAllPairsLimit);
+      continue;
+    }
+    Row r;
+    try {
+      r = measure<Dim>(x, radius, {.method = m, .subdivision = a.subdivision}, a.repeat);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      std::printf("  %-13s not available: %s\n", name.c_str(), e.what());
+      std::fflush(stdout);
+      continue;
+    }
+    const SearchStats& s = r.stats;
+    std::string check;
+    if (!reference) {
+      reference = r.checksum;
+      reference_name = name;
+      check = "reference";
+    } else {
+      check = r.checksum == *reference ? "same as " + reference_name : "DIFFERS from " + reference_name;
+    }
+    char peak[32] = "n/a", ratio[32] = "n/a";
+    if (r.peak_growth_bytes) {
+      std::snprintf(peak, sizeof peak, "%.1f", mib(*r.peak_growth_bytes));
+      if (r.lists_bytes > 0)
+        std::snprintf(ratio, sizeof ratio, "%.2f",
+                      static_cast<double>(*r.peak_growth_bytes) / static_cast<double>(r.lists_bytes));
+    }
+    const double per_nbr =
+        s.pairs > 0 ? static_cast<double>(s.candidates) / static_cast<double>(s.pairs) : 0.0;
+    std::printf("  %-13s %10.2f %10.2f %10.2f %12llu %9.2f %10.1f %10.1f %10s %7s  %s\n", name.c_str(),
+                s.build_ms, s.query_ms, s.build_ms + s.query_ms, static_cast<unsigned long long>(s.pairs),
+                per_nbr, mib(s.memory_bytes), mib(r.lists_bytes), peak, ratio, check.c_str());
+    std::fflush(stdout);
+  }
+}
+
+template <int Dim>
+void bench_neighbors(const BenchArgs& a, const std::vector<Method>& methods,
+                     const std::vector<std::size_t>& sizes, const std::vector<double>& radii,
+                     const std::vector<std::string>& sets) {
+  if constexpr (Dim == 3) {
+    const auto dam = point_sets::paper_dam_break<3, double>();
+    bench_set<3>("dam-break (paper sec. 5): n=1600, 10x20x8 lattice, spacing 0.010627 m, h=0.05 m", dam,
+                 point_sets::kPaperDamBreakH, methods, a);
+  } else {
+    std::printf("\n(dam-break set skipped: the paper's set is 3D)\n");
+  }
+  const double s = 1.0;  // lattice spacing; radii are given in units of it
+  for (std::size_t n : sizes) {
+    for (const std::string& set : sets) {
+      std::vector<Vec<Dim, double>> x;
+      std::string what;
+      if (set == "lattice") {
+        x = point_sets::jittered_lattice<Dim, double>(n, s, 0.01);
+        what = "jittered lattice (jitter 0.01 s)";
+      } else if (set == "uniform") {
+        // At the lattice's density: n as requested, box side n^(1/Dim) s.
+        x = point_sets::uniform_random<Dim, double>(n, s);
+        what = "uniform random, lattice density";
+      } else {
+        x = point_sets::clustered<Dim, double>(n, s);
+        what = "clustered (8 Gaussian blobs)";
+      }
+      for (double r : radii) {
+        char title[160];
+        std::snprintf(title, sizeof title, "%s, %dD, n=%zu, r=%gs", what.c_str(), Dim, x.size(), r);
+        bench_set<Dim>(title, x, r * s, methods, a);
+      }
+    }
+  }
+}
+
+void run_bench_neighbors(const BenchArgs& a) {
+  std::vector<Method> methods;
+  if (a.methods.empty()) {
+    methods.assign(std::begin(kAllMethods), std::end(kAllMethods));
+  } else {
+    for (const auto& name : split(a.methods)) {
+      const auto m = parse_method(name);
+      if (!m)
+        throw InputError("--methods: unknown method '" + name + "' (expected a comma-separated list of " +
+                         method_names_joined(",") + ")");
+      methods.push_back(*m);
+    }
+  }
+  auto sizes = parse_list<std::size_t>("--sizes", a.sizes, 1);
+  if (a.quick) sizes = {3000};
+  const auto radii = parse_list<double>("--radii", a.radii, std::numeric_limits<double>::min());
+  const auto sets = split(a.sets);
+  for (const auto& set : sets)
+    if (set != "lattice" && set != "uniform" && set != "clustered")
+      throw InputError("--sets: unknown point set '" + set + "' (expected lattice,uniform,clustered)");
+  if (a.subdivision < 1)
+    throw InputError("--subdivision: must be >= 1, got " + std::to_string(a.subdivision));
+  if (a.threads_given && a.threads < 1)
+    throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
+  if (a.repeat < 1) throw InputError("--repeat: must be >= 1, got " + std::to_string(a.repeat));
+  if (a.dim != 2 && a.dim != 3) throw InputError("--dim: must be 2 or 3, got " + std::to_string(a.dim));
+
+  ScopedThreads threads(a.threads_given ? a.threads : max_threads());
+  std::printf(
+      "cellsph bench neighbors: %dD, double, %d thread(s), subdivision H=%d, best of up to %d run(s)\n",
+      a.dim, max_threads(), a.subdivision, a.repeat);
+  std::printf(
+      "  times: build = structure, query = all CSR lists (NeighborSearch::find_all); cand/nbr = distance\n"
+      "  tests per neighbour found; stats = memory_bytes reported by the search; lists = CSR size;\n"
+      "  peak = growth of peak RSS (VmHWM) during build+query; peak/l = peak / lists size.\n");
+  std::fflush(stdout);
+  if (a.dim == 2)
+    bench_neighbors<2>(a, methods, sizes, radii, sets);
+  else
+    bench_neighbors<3>(a, methods, sizes, radii, sets);
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app, int& result) {
+  auto* sub = app.add_subcommand("bench", "Benchmarks (run without a name to list them)");
+  sub->require_subcommand(0, 1);
+
+  auto args = std::make_shared<BenchArgs>();
+  auto* nb = sub->add_subcommand("neighbors", "Neighbour search: every method on the paper's point sets");
+  nb->add_option("--sizes", args->sizes, "comma-separated particle counts")->capture_default_str();
+  nb->add_option("--methods", args->methods,
+                 "comma-separated methods (default: all): " + method_names_joined(","));
+  nb->add_option("--radii", args->radii, "comma-separated radii in lattice spacings")->capture_default_str();
+  nb->add_option("--sets", args->sets, "comma-separated point sets")->capture_default_str();
+  auto* threads = nb->add_option("--threads", args->threads, "threads (default: all cores)");
+  nb->add_option("--subdivision", args->subdivision, "subdivision factor H (cells of size h/H)")
+      ->capture_default_str();
+  nb->add_option("--dim", args->dim, "dimension, 2 or 3 (the dam-break set is 3D only)")
+      ->capture_default_str();
+  nb->add_option("--repeat", args->repeat, "runs per measurement; the fastest is reported")
+      ->capture_default_str();
+  nb->add_flag("--quick", args->quick, "small sizes only (3000 points), for tests and docs");
+  nb->callback([args, threads, &result] {
+    args->threads_given = threads->count() > 0;
+    run_bench_neighbors(*args);
+    result = 0;
+  });
+
+  sub->callback([sub, &result] {
+    if (!sub->get_subcommands().empty()) return;
+    std::cout << "Benchmarks (cellsph bench NAME --help for options):\n";
+    for (const auto* s : sub->get_subcommands([](const CLI::App*) { return true; }))
+      std::cout << "  " << s->get_name() << "  " << s->get_description() << "\n";
+    result = 0;
+  });
+}
+
 }  // namespace cellsph::app

@@ -64,4 +64,26 @@ std::vector<Vec<Dim, Real>> clustered(std::size_t n, Real s, int blobs = 8, std:
   return x;
 }
 
+// The dam-break set of the paper's section 5 (Table 1): 1600 particles with rest density
+// rho_0 = 1000 kg/m^3, mass m = 0.0012 kg and support length h = 0.05 m (kPaperDamBreakH). Density
+// and mass are volumetric, so the set is 3D with particle spacing (m / rho_0)^(1/3) = 0.010627 m;
+// the particles fill a column of 10 (x) by 20 (y, up) by 8 (z) lattice sites from the origin.
+// At that spacing h reaches about 4.7 spacings: an interior particle has 460 neighbours.
+inline constexpr double kPaperDamBreakH = 0.05;
+inline constexpr int kPaperDamBreakBlock[3] = {10, 20, 8};
+
+template <int Dim, class Real>
+std::vector<Vec<Dim, Real>> paper_dam_break() {
+  static_assert(Dim == 3, "the paper's dam-break set is volumetric (kg/m^3): 3D only");
+  const double spacing = std::cbrt(0.0012 / 1000.0);
+  std::vector<Vec<Dim, Real>> x;
+  x.reserve(1600);
+  for (int k = 0; k < kPaperDamBreakBlock[2]; ++k)
+    for (int j = 0; j < kPaperDamBreakBlock[1]; ++j)
+      for (int i = 0; i < kPaperDamBreakBlock[0]; ++i)
+        x.push_back(Vec<Dim, Real>{{static_cast<Real>(i * spacing), static_cast<Real>(j * spacing),
+                                    static_cast<Real>(k * spacing)}});
+  return x;
+}
+
 }  // namespace cellsph::point_sets
