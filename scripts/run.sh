@@ -5,4 +5,5 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build/release -j "$(nproc)" >/dev/null
-exec build/release/cellsph "${@:-bench}" 
+if [ $# -eq 0 ]; then set -- run; fi
+exec build/release/cellsph "$@"
