@@ -10,6 +10,9 @@ cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build/release -j "$JOBS"
 ctest --test-dir build/release -j "$JOBS" --output-on-failure
 
+echo "== commands of README.md and docs/ =="
+scripts/check_docs.sh build/release
+
 echo "== ASan + UBSan build =="
 cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLSPH_SANITIZE=ON \
   -DCELLSPH_BUILD_BENCHMARKS=OFF >/dev/null
