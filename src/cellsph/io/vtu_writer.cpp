@@ -59,8 +59,10 @@ std::uint64_t block_size(const Vector& field) {
          static_cast<std::uint64_t>(field.size()) * vtk_components<FT>() * sizeof(typename FT::Scalar);
 }
 
+// NumberOfTuples is written on every array: VTK's reader needs it on FieldData arrays (it reads zero
+// tuples without it) and ignores nothing by having it elsewhere.
 template <class Vector>
-void data_array_tag(std::string& xml, std::string_view name, std::uint64_t offset) {
+void data_array_tag(std::string& xml, std::string_view name, std::uint64_t offset, std::size_t tuples) {
   using FT = io::FieldOf<Vector>;
   xml += "        <DataArray type=\"";
   xml += io::vtk_type_name<typename FT::Scalar>();
@@ -68,6 +70,8 @@ void data_array_tag(std::string& xml, std::string_view name, std::uint64_t offse
   xml += name;
   xml += "\" NumberOfComponents=\"";
   xml += std::to_string(vtk_components<FT>());
+  xml += "\" NumberOfTuples=\"";
+  xml += std::to_string(tuples);
   xml += "\" format=\"appended\" offset=\"";
   xml += std::to_string(offset);
   xml += "\"/>\n";
@@ -108,27 +112,27 @@ void write_vtu(const Particles<Dim, Real>& particles, double time, const std::fi
   xml += "  <UnstructuredGrid>\n";
   std::uint64_t offset = 0;
   xml += "    <FieldData>\n";
-  data_array_tag<std::vector<double>>(xml, "TimeValue", offset);
+  data_array_tag<std::vector<double>>(xml, "TimeValue", offset, 1);
   offset += block_size(time_value);
   xml += "    </FieldData>\n";
   xml += "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(n) + "\">\n";
   xml += "      <PointData>\n";
   particles.for_each_field([&](std::string_view name, const auto& field) {
     if (name == "position") return;  // stored once, as the grid's Points
-    data_array_tag<std::remove_cvref_t<decltype(field)>>(xml, name, offset);
+    data_array_tag<std::remove_cvref_t<decltype(field)>>(xml, name, offset, field.size());
     offset += block_size(field);
   });
   xml += "      </PointData>\n";
   xml += "      <Points>\n";
-  data_array_tag<std::remove_cvref_t<decltype(particles.x)>>(xml, "position", offset);
+  data_array_tag<std::remove_cvref_t<decltype(particles.x)>>(xml, "position", offset, n);
   offset += block_size(particles.x);
   xml += "      </Points>\n";
   xml += "      <Cells>\n";
-  data_array_tag<decltype(connectivity)>(xml, "connectivity", offset);
+  data_array_tag<decltype(connectivity)>(xml, "connectivity", offset, n);
   offset += block_size(connectivity);
-  data_array_tag<decltype(offsets)>(xml, "offsets", offset);
+  data_array_tag<decltype(offsets)>(xml, "offsets", offset, n);
   offset += block_size(offsets);
-  data_array_tag<decltype(types)>(xml, "types", offset);
+  data_array_tag<decltype(types)>(xml, "types", offset, n);
   xml += "      </Cells>\n";
   xml += "    </Piece>\n";
   xml += "  </UnstructuredGrid>\n";

@@ -18,6 +18,7 @@ struct ArrayTag {
   std::string type;
   int components = 0;
   std::uint64_t offset = 0;
+  std::uint64_t tuples = 0;
 };
 
 std::string attr(const std::string& tag, const std::string& key) {
@@ -63,7 +64,7 @@ ParsedVtu parse_vtu(const std::filesystem::path& path) {
     if (tag.rfind("<DataArray", 0) == 0) {
       EXPECT_EQ(attr(tag, "format"), "appended") << tag;
       ArrayTag a{section, attr(tag, "type"), std::stoi(attr(tag, "NumberOfComponents")),
-                 std::stoull(attr(tag, "offset"))};
+                 std::stoull(attr(tag, "offset")), std::stoull(attr(tag, "NumberOfTuples"))};
       EXPECT_TRUE(r.arrays.emplace(attr(tag, "Name"), a).second) << "duplicate array " << tag;
     }
   }
@@ -107,6 +108,13 @@ void check_vtu_round_trip() {
   EXPECT_EQ(v.arrays.at("position").components, 3);
   EXPECT_EQ(v.arrays.at("TimeValue").section, "FieldData");
   EXPECT_EQ(v.block<double>("TimeValue"), std::vector<double>{1.25});
+  // VTK reads FieldData arrays only as far as their NumberOfTuples says.
+  EXPECT_EQ(v.arrays.at("TimeValue").tuples, 1u);
+  for (const auto& [name, a] : v.arrays) {
+    if (name != "TimeValue") {
+      EXPECT_EQ(a.tuples, n) << name;
+    }
+  }
 
   // Blocks tile the appended section exactly, in offset order, each sized by its header.
   std::vector<std::pair<std::uint64_t, std::string>> order;
