@@ -47,8 +47,10 @@ void put(std::string& out, const T& v) {
 }
 
 void put_string(std::string& out, std::string_view s, bool short_len) {
-  if (short_len) put(out, static_cast<std::uint32_t>(s.size()));
-  else put(out, static_cast<std::uint64_t>(s.size()));
+  if (short_len)
+    put(out, static_cast<std::uint32_t>(s.size()));
+  else
+    put(out, static_cast<std::uint64_t>(s.size()));
   out.append(s);
 }
 
@@ -109,9 +111,11 @@ std::string read_all(const std::filesystem::path& path) {
 CheckpointHeader parse_header(Cursor& c) {
   // A short file that does not even start like a checkpoint is "not a checkpoint", not "truncated".
   const auto head = c.peek(sizeof(kMagic));
-  if (std::memcmp(head.data(), kMagic, head.size()) != 0) c.fail("bad magic number: not a cellsph checkpoint");
+  if (std::memcmp(head.data(), kMagic, head.size()) != 0)
+    c.fail("bad magic number: not a cellsph checkpoint");
   const auto magic = c.get_bytes(sizeof(kMagic), "the magic number");
-  if (std::memcmp(magic.data(), kMagic, sizeof(kMagic)) != 0) c.fail("bad magic number: not a cellsph checkpoint");
+  if (std::memcmp(magic.data(), kMagic, sizeof(kMagic)) != 0)
+    c.fail("bad magic number: not a cellsph checkpoint");
   CheckpointHeader h;
   h.version = c.get<std::uint32_t>("the format version");
   if (h.version != kCheckpointVersion)
@@ -127,7 +131,9 @@ CheckpointHeader parse_header(Cursor& c) {
   return h;
 }
 
-const char* precision_name(int size) { return size == 4 ? "float" : size == 8 ? "double" : "unknown"; }
+const char* precision_name(int size) {
+  return size == 4 ? "float" : size == 8 ? "double" : "unknown";
+}
 
 }  // namespace
 
@@ -156,7 +162,8 @@ void write_checkpoint(const Particles<Dim, Real>& particles, const CheckpointInf
     using T = typename std::remove_cvref_t<decltype(field)>::value_type;
     static_assert(std::is_trivially_copyable_v<T>, "checkpointed fields must be trivially copyable");
     CELLSPH_CHECK(field.size() == particles.size(), "field '" << name << "' has " << field.size()
-                                                              << " elements for " << particles.size() << " particles");
+                                                              << " elements for " << particles.size()
+                                                              << " particles");
     put_string(out, name, true);
     put(out, static_cast<std::uint32_t>(sizeof(T)));
     put(out, static_cast<std::uint64_t>(field.size()));
@@ -187,7 +194,8 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim,
   Cursor c(path, bytes, body);
   const CheckpointHeader h = parse_header(c);
   if (h.dim != Dim)
-    c.fail("written by a " + std::to_string(h.dim) + "D run, cannot continue a " + std::to_string(Dim) + "D run");
+    c.fail("written by a " + std::to_string(h.dim) + "D run, cannot continue a " + std::to_string(Dim) +
+           "D run");
   if (h.real_size != static_cast<int>(sizeof(Real)))
     c.fail(std::string("precision mismatch: file holds ") + precision_name(h.real_size) + " (" +
            std::to_string(h.real_size) + " bytes), this run uses " + precision_name(sizeof(Real)));
@@ -201,7 +209,8 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim,
   std::size_t per_particle = 0;
   particles.for_each_field([&](std::string_view, const auto& field) { per_particle += sizeof(field[0]); });
   if (per_particle && h.count > (body - c.pos()) / per_particle)
-    c.fail("truncated or corrupt: " + std::to_string(h.count) + " particles need more bytes than the file has");
+    c.fail("truncated or corrupt: " + std::to_string(h.count) +
+           " particles need more bytes than the file has");
   Particles<Dim, Real> loaded;
   loaded.resize(static_cast<std::size_t>(h.count));
   std::set<std::string, std::less<>> known, seen;
@@ -211,7 +220,8 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim,
     const auto what = "field " + std::to_string(fi + 1) + " of " + std::to_string(nfields);
     const auto name_len = c.get<std::uint32_t>(what + " (name length)");
     const std::string name(c.get_bytes(name_len, what + " (name)"));
-    if (!known.count(name)) c.fail("unknown field '" + name + "' (" + what + "); this build does not have it");
+    if (!known.count(name))
+      c.fail("unknown field '" + name + "' (" + what + "); this build does not have it");
     if (!seen.insert(name).second) c.fail("field '" + name + "' appears twice");
     const auto elem_size = c.get<std::uint32_t>("the element size of field '" + name + "'");
     const auto count = c.get<std::uint64_t>("the element count of field '" + name + "'");
@@ -224,11 +234,13 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim,
         c.fail("field '" + name + "' has elements of " + std::to_string(elem_size) + " bytes, expected " +
                std::to_string(sizeof(T)));
       if (count != h.count)
-        c.fail("field '" + name + "' has " + std::to_string(count) + " elements for " + std::to_string(h.count) +
-               " particles");
+        c.fail("field '" + name + "' has " + std::to_string(count) + " elements for " +
+               std::to_string(h.count) + " particles");
       if (count > (body - c.pos()) / sizeof(T))  // checked by division: a corrupt count must not overflow
-        c.fail("truncated: file ends at byte " + std::to_string(body) + " inside the data of field '" + name + "'");
-      const auto data = c.get_bytes(static_cast<std::size_t>(count) * sizeof(T), "the data of field '" + name + "'");
+        c.fail("truncated: file ends at byte " + std::to_string(body) + " inside the data of field '" + name +
+               "'");
+      const auto data =
+          c.get_bytes(static_cast<std::size_t>(count) * sizeof(T), "the data of field '" + name + "'");
       if (count) std::memcpy(field.data(), data.data(), data.size());
     });
     CELLSPH_CHECK(found, name);
@@ -236,7 +248,8 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim,
   for (const auto& name : known)
     if (!seen.count(name)) c.fail("missing field '" + name + "'");
   if (c.pos() != body)
-    c.fail(std::to_string(body - c.pos()) + " unexpected bytes after the last field (corrupted or wrong format)");
+    c.fail(std::to_string(body - c.pos()) +
+           " unexpected bytes after the last field (corrupted or wrong format)");
   std::uint64_t stored;
   std::memcpy(&stored, bytes.data() + body, sizeof(stored));
   if (stored != checksum(bytes.data(), body)) c.fail("checksum mismatch: the file is corrupted");
@@ -244,9 +257,9 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim,
   return info;
 }
 
-#define CELLSPH_CHECKPOINT_INSTANTIATE(D, R)                                                               \
-  template void write_checkpoint<D, R>(const Particles<D, R>&, const CheckpointInfo&,                      \
-                                       const std::filesystem::path&);                                      \
+#define CELLSPH_CHECKPOINT_INSTANTIATE(D, R)                                          \
+  template void write_checkpoint<D, R>(const Particles<D, R>&, const CheckpointInfo&, \
+                                       const std::filesystem::path&);                 \
   template CheckpointInfo read_checkpoint<D, R>(const std::filesystem::path&, Particles<D, R>&);
 CELLSPH_CHECKPOINT_INSTANTIATE(2, float)
 CELLSPH_CHECKPOINT_INSTANTIATE(2, double)

@@ -14,7 +14,8 @@ namespace {
 
 // Fields that have their fixed place at the front of the row.
 bool leading_field(std::string_view name) {
-  return name == "position" || name == "velocity" || name == "density" || name == "pressure" || name == "phase";
+  return name == "position" || name == "velocity" || name == "density" || name == "pressure" ||
+         name == "phase";
 }
 
 template <class Vector>
@@ -85,7 +86,8 @@ std::string csv_header() {
 }
 
 template <int Dim, class Real>
-void write_csv(const Particles<Dim, Real>& particles, const std::filesystem::path& path, const CsvRowFilter& keep) {
+void write_csv(const Particles<Dim, Real>& particles, const std::filesystem::path& path,
+               const CsvRowFilter& keep) {
   AtomicFile file(path, true);
   auto& out = file.stream();
   const std::string header = csv_header<Dim, Real>() + "\n";
@@ -112,10 +114,9 @@ void write_csv(const Particles<Dim, Real>& particles, const std::filesystem::pat
   file.commit();
 }
 
-#define CELLSPH_CSV_INSTANTIATE(D, R)                   \
-  template std::string csv_header<D, R>();              \
-  template void write_csv<D, R>(const Particles<D, R>&, \
-                                const std::filesystem::path&, const CsvRowFilter&);
+#define CELLSPH_CSV_INSTANTIATE(D, R)      \
+  template std::string csv_header<D, R>(); \
+  template void write_csv<D, R>(const Particles<D, R>&, const std::filesystem::path&, const CsvRowFilter&);
 CELLSPH_CSV_INSTANTIATE(2, float)
 CELLSPH_CSV_INSTANTIATE(2, double)
 CELLSPH_CSV_INSTANTIATE(3, float)

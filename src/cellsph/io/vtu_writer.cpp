@@ -81,11 +81,20 @@ std::string xml_escape(std::string_view s) {
   std::string r;
   for (const char c : s) {
     switch (c) {
-      case '&': r += "&amp;"; break;
-      case '<': r += "&lt;"; break;
-      case '>': r += "&gt;"; break;
-      case '"': r += "&quot;"; break;
-      default: r += c;
+      case '&':
+        r += "&amp;";
+        break;
+      case '<':
+        r += "&lt;";
+        break;
+      case '>':
+        r += "&gt;";
+        break;
+      case '"':
+        r += "&quot;";
+        break;
+      default:
+        r += c;
     }
   }
   return r;
@@ -108,14 +117,17 @@ void write_vtu(const Particles<Dim, Real>& particles, double time, const std::fi
   // Header first: the offsets of the appended blocks follow from the field sizes alone.
   std::string xml;
   xml += "<?xml version=\"1.0\"?>\n";
-  xml += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n";
+  xml +=
+      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n";
   xml += "  <UnstructuredGrid>\n";
   std::uint64_t offset = 0;
   xml += "    <FieldData>\n";
   data_array_tag<std::vector<double>>(xml, "TimeValue", offset, 1);
   offset += block_size(time_value);
   xml += "    </FieldData>\n";
-  xml += "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(n) + "\">\n";
+  xml += "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(n) +
+         "\">\n";
   xml += "      <PointData>\n";
   particles.for_each_field([&](std::string_view name, const auto& field) {
     if (name == "position") return;  // stored once, as the grid's Points
@@ -193,7 +205,8 @@ bool attribute(std::string_view tag, std::string_view key, std::string& value) {
 }
 
 std::string xml_unescape(std::string s) {
-  const std::pair<std::string_view, char> ents[] = {{"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&amp;", '&'}};
+  const std::pair<std::string_view, char> ents[] = {
+      {"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&amp;", '&'}};
   for (const auto& [e, c] : ents) {
     for (auto p = s.find(e); p != std::string::npos; p = s.find(e, p + 1)) s.replace(p, e.size(), 1, c);
   }
@@ -212,7 +225,8 @@ std::vector<PvdEntry> read_pvd(const std::filesystem::path& path) {
   std::vector<PvdEntry> entries;
   for (auto p = text.find("<DataSet"); p != std::string::npos; p = text.find("<DataSet", p + 1)) {
     const auto end = text.find("/>", p);
-    if (end == std::string::npos) throw InputError(std::string("'") + path.string() + "': unterminated DataSet tag");
+    if (end == std::string::npos)
+      throw InputError(std::string("'") + path.string() + "': unterminated DataSet tag");
     const std::string_view tag(text.data() + p, end - p);
     std::string t, f;
     PvdEntry e;

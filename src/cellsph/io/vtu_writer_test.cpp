@@ -94,10 +94,9 @@ void check_vtu_round_trip() {
   const std::string real = sizeof(Real) == 4 ? "Float32" : "Float64";
   // Every field of the list, written out here by hand, with its VTK type and width.
   const std::map<std::string, std::pair<std::string, int>> expected = {
-      {"velocity", {real, 3}}, {"force", {real, 3}},     {"mass", {real, 1}},
-      {"density", {real, 1}},  {"pressure", {real, 1}},  {"support", {real, 1}},
-      {"color", {real, 1}},    {"viscosity", {real, 1}}, {"phase", {"Int32", 1}},
-      {"level", {"Int32", 1}}};
+      {"velocity", {real, 3}}, {"force", {real, 3}},   {"mass", {real, 1}},  {"density", {real, 1}},
+      {"pressure", {real, 1}}, {"support", {real, 1}}, {"color", {real, 1}}, {"viscosity", {real, 1}},
+      {"phase", {"Int32", 1}}, {"level", {"Int32", 1}}};
   for (const auto& [name, tc] : expected) {
     ASSERT_TRUE(v.arrays.count(name)) << name;
     EXPECT_EQ(v.arrays.at(name).section, "PointData") << name;
@@ -166,9 +165,15 @@ void check_vtu_round_trip() {
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"frame.vtu"});
 }
 
-TEST(VtuWriter, RoundTrip2DFloat) { check_vtu_round_trip<2, float>(); }
-TEST(VtuWriter, RoundTrip3DDouble) { check_vtu_round_trip<3, double>(); }
-TEST(VtuWriter, RoundTrip3DFloat) { check_vtu_round_trip<3, float>(); }
+TEST(VtuWriter, RoundTrip2DFloat) {
+  check_vtu_round_trip<2, float>();
+}
+TEST(VtuWriter, RoundTrip3DDouble) {
+  check_vtu_round_trip<3, double>();
+}
+TEST(VtuWriter, RoundTrip3DFloat) {
+  check_vtu_round_trip<3, float>();
+}
 
 TEST(VtuWriter, EmptyParticleSetIsValid) {
   test::TempDir dir("vtu_empty");
@@ -197,12 +202,14 @@ TEST(PvdWriter, ListsEveryFrameWithItsTimeAfterEachAdd) {
   PvdWriter pvd(dir / "run.pvd");
   pvd.add(0.0, "frame_00000.vtu");
   const std::string one = test::slurp(dir / "run.pvd");
-  EXPECT_NE(one.find("<DataSet timestep=\"0\" group=\"\" part=\"0\" file=\"frame_00000.vtu\"/>"), std::string::npos);
+  EXPECT_NE(one.find("<DataSet timestep=\"0\" group=\"\" part=\"0\" file=\"frame_00000.vtu\"/>"),
+            std::string::npos);
   EXPECT_EQ(one.find("frame_00001"), std::string::npos);
   pvd.add(0.1, "frame_00001.vtu");
   const std::string two = test::slurp(dir / "run.pvd");
   EXPECT_NE(two.find("type=\"Collection\""), std::string::npos);
-  EXPECT_NE(two.find("<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"frame_00001.vtu\"/>"), std::string::npos);
+  EXPECT_NE(two.find("<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"frame_00001.vtu\"/>"),
+            std::string::npos);
   EXPECT_NE(two.rfind("</VTKFile>\n"), std::string::npos);
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"run.pvd"});
 

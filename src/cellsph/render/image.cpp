@@ -30,8 +30,10 @@ void Image::blend(int x, int y, Rgb8 c, double a) {
 void Image::fill_rect(int x0, int y0, int x1, int y1, Rgb8 c, double a) {
   for (int y = std::max(0, y0); y < std::min(height, y1); ++y)
     for (int x = std::max(0, x0); x < std::min(width, x1); ++x) {
-      if (a >= 1) set(x, y, c);
-      else blend(x, y, c, a);
+      if (a >= 1)
+        set(x, y, c);
+      else
+        blend(x, y, c, a);
     }
 }
 
@@ -54,7 +56,9 @@ std::string encode_png(const Image& image) {
   return bytes;
 }
 
-void write_png(const Image& image, const std::filesystem::path& path) { write_file_atomic(path, encode_png(image)); }
+void write_png(const Image& image, const std::filesystem::path& path) {
+  write_file_atomic(path, encode_png(image));
+}
 
 Image read_png(const std::filesystem::path& path) {
   png_image png{};

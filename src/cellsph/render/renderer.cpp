@@ -19,23 +19,35 @@ constexpr double kPi = 3.14159265358979323846;
 struct V3 {
   double x = 0, y = 0, z = 0;
 };
-V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+V3 operator+(V3 a, V3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+V3 operator-(V3 a, V3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V3 operator*(double s, V3 a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+double dot(V3 a, V3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 V3 normalized(V3 a) {
   const double n = std::sqrt(dot(a, a));
   return n > 0 ? (1 / n) * a : a;
 }
-V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+V3 to_v3(const std::array<double, 3>& a) {
+  return {a[0], a[1], a[2]};
+}
 
 // Pinhole or parallel projection onto the (supersampled) frame buffer. View coordinates: right, up,
 // and depth along the viewing direction (positive in front of the camera).
 struct View {
   V3 eye, right, up, fwd;
   bool ortho = false;
-  double focal = 1;  // perspective: pixels per unit of (lateral / depth); ortho: pixels per world unit
+  double focal = 1;       // perspective: pixels per unit of (lateral / depth); ortho: pixels per world unit
   double cx = 0, cy = 0;  // screen position of the optical axis
   double near = 1e-9;
 
@@ -55,7 +67,9 @@ struct View {
     sy = cy - focal * v.y / v.z;
     return true;
   }
-  [[nodiscard]] double pixel_radius(double r, double depth) const { return ortho ? focal * r : focal * r / depth; }
+  [[nodiscard]] double pixel_radius(double r, double depth) const {
+    return ortho ? focal * r : focal * r / depth;
+  }
 };
 
 struct Sprite {
@@ -69,7 +83,9 @@ struct FrameBuffer {
   std::vector<float> rgb;
   std::vector<float> depth;
   FrameBuffer(int width, int height, Rgb8 bg)
-      : w(width), h(height), rgb(3 * static_cast<std::size_t>(width) * height),
+      : w(width),
+        h(height),
+        rgb(3 * static_cast<std::size_t>(width) * height),
         depth(static_cast<std::size_t>(width) * height, std::numeric_limits<float>::infinity()) {
     for (std::size_t i = 0; i < rgb.size(); i += 3)
       for (int k = 0; k < 3; ++k) rgb[i + k] = static_cast<float>(bg[k]);
@@ -115,8 +131,8 @@ void shade_sprites(FrameBuffer& fb, const View& view, const std::vector<Sprite>&
 }
 
 // A world-space segment, `thickness` pixels wide; depth-tested unless depth_test is false.
-void draw_segment(FrameBuffer& fb, const View& view, V3 a, V3 b, double thickness, Rgb8 colour, bool depth_test,
-                  double bias) {
+void draw_segment(FrameBuffer& fb, const View& view, V3 a, V3 b, double thickness, Rgb8 colour,
+                  bool depth_test, double bias) {
   V3 va = view.to_view(a), vb = view.to_view(b);
   if (!view.ortho) {  // clip against the near plane
     const double nearz = 1e-6;
@@ -304,7 +320,9 @@ void box_edges(int dim, const RenderBox& box, std::vector<std::pair<V3, V3>>& ed
     edges = {{a, b}, {b, c}, {c, d}, {d, a}};
     return;
   }
-  auto corner = [&](int i) { return V3{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z}; };
+  auto corner = [&](int i) {
+    return V3{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z};
+  };
   for (int i = 0; i < 8; ++i)
     for (int bit = 1; bit < 8; bit <<= 1)
       if (!(i & bit)) edges.emplace_back(corner(i), corner(i | bit));
@@ -313,7 +331,8 @@ void box_edges(int dim, const RenderBox& box, std::vector<std::pair<V3, V3>>& ed
 const Rgb8 kInk{25, 25, 25};
 
 void draw_label(Image& img, int x, int y, const std::string& text, int font, Rgb8 bg) {
-  img.fill_rect(x - font, y - font, x + text_width(text, font) + font, y + text_height(font) + font, bg, 0.75);
+  img.fill_rect(x - font, y - font, x + text_width(text, font) + font, y + text_height(font) + font, bg,
+                0.75);
   draw_text(img, x, y, text, kInk, font);
 }
 
@@ -328,7 +347,7 @@ ColorBy parse_color_by(std::string_view name, std::string_view what) {
 }
 
 Rgb8 phase_colour(int phase) {
-  static constexpr Rgb8 palette[8] = {{40, 110, 220}, {240, 140, 30}, {50, 170, 80}, {210, 50, 50},
+  static constexpr Rgb8 palette[8] = {{40, 110, 220}, {240, 140, 30}, {50, 170, 80},   {210, 50, 50},
                                       {150, 90, 200}, {140, 90, 50},  {230, 110, 180}, {20, 170, 180}};
   if (phase < 0) return {150, 150, 150};
   return palette[phase % 8];
@@ -455,7 +474,7 @@ void render_png(const Particles<Dim, Real>& particles, const RenderOptions& opti
   write_png(render_image(particles, options, box, time), path);
 }
 
-#define CELLSPH_RENDER_INSTANTIATE(D, R)                                                                   \
+#define CELLSPH_RENDER_INSTANTIATE(D, R)                                                                     \
   template Image render_image<D, R>(const Particles<D, R>&, const RenderOptions&, const RenderBox&, double); \
   template void render_png<D, R>(const Particles<D, R>&, const RenderOptions&, const RenderBox&, double,     \
                                  const std::filesystem::path&);

@@ -13,8 +13,12 @@ namespace cellsph {
 namespace {
 
 // Colour classes judged from the pixel alone, independent of the renderer's palette code.
-bool bluish(Rgb8 c) { return c[2] > c[0] + 40 && c[2] > c[1] + 20; }
-bool orangeish(Rgb8 c) { return c[0] > c[2] + 60 && c[0] > c[1]; }
+bool bluish(Rgb8 c) {
+  return c[2] > c[0] + 40 && c[2] > c[1] + 20;
+}
+bool orangeish(Rgb8 c) {
+  return c[0] > c[2] + 60 && c[0] > c[1];
+}
 bool dark_grey(Rgb8 c) {
   const int mx = std::max({c[0], c[1], c[2]}), mn = std::min({c[0], c[1], c[2]});
   return mx < 140 && mx - mn < 12;
@@ -73,10 +77,12 @@ TEST(Renderer, TwoDimensionalDiscsSitWhereTheParticlesAre) {
   EXPECT_TRUE(bluish(img.at(px(0.5), py(0.5))));
   EXPECT_TRUE(orangeish(img.at(px(1.5), py(0.5))));
   for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
-    const int ox = static_cast<int>(std::lround(0.6 * r * dx)), oy = static_cast<int>(std::lround(0.6 * r * dy));
+    const int ox = static_cast<int>(std::lround(0.6 * r * dx)),
+              oy = static_cast<int>(std::lround(0.6 * r * dy));
     EXPECT_TRUE(bluish(img.at(px(0.5) + ox, py(0.5) + oy))) << dx << "," << dy;
     EXPECT_TRUE(orangeish(img.at(px(1.5) + ox, py(0.5) + oy))) << dx << "," << dy;
-    const int fx = static_cast<int>(std::lround(1.4 * r * dx)), fy = static_cast<int>(std::lround(1.4 * r * dy));
+    const int fx = static_cast<int>(std::lround(1.4 * r * dx)),
+              fy = static_cast<int>(std::lround(1.4 * r * dy));
     EXPECT_EQ(img.at(px(0.5) + fx, py(0.5) + fy), kBackground) << dx << "," << dy;
     EXPECT_EQ(img.at(px(1.5) + fx, py(0.5) + fy), kBackground) << dx << "," << dy;
   }
@@ -174,7 +180,7 @@ TEST(Renderer, SpeedColourMapAndExplicitRange) {
   const double s = 0.96 * 300;
   auto px = [&](double w) { return static_cast<int>(std::lround(150 + (w - 0.5) * s)); };
   const Image img = render_image(p, o, box, 0.0);
-  EXPECT_TRUE(bluish(img.at(px(0.25), 150)));  // slowest end of the map
+  EXPECT_TRUE(bluish(img.at(px(0.25), 150)));                             // slowest end of the map
   EXPECT_TRUE(img.at(px(0.75), 150)[0] > img.at(px(0.75), 150)[2] + 60);  // fastest: red
   o.range_min = 0.0;
   o.range_max = 10.0;  // now 2 m/s is low in the range
@@ -203,9 +209,9 @@ TEST(Renderer, LabelsAppearOnlyWhenAsked) {
       for (int x = x0; x < x1; ++x) n += dark_grey(img.at(x, y));
     return n;
   };
-  EXPECT_GT(ink_in(with, 0, 0, 200, 40), 50);         // "t = 1.250 s"
-  EXPECT_GT(ink_in(with, 0, 660, 300, 720), 50);      // scale bar and its label
-  EXPECT_GT(ink_in(with, 1050, 0, 1280, 40), 20);     // legend
+  EXPECT_GT(ink_in(with, 0, 0, 200, 40), 50);      // "t = 1.250 s"
+  EXPECT_GT(ink_in(with, 0, 660, 300, 720), 50);   // scale bar and its label
+  EXPECT_GT(ink_in(with, 1050, 0, 1280, 40), 20);  // legend
   o.time_label = o.scale_bar = o.legend = false;
   const Image without = render_image(p, o, box, 1.25);
   EXPECT_EQ(ink_in(without, 0, 0, 200, 40), 0);
@@ -260,11 +266,13 @@ TEST(Video, MissingFfmpegIsReportedNotFatal) {
 }
 
 TEST(Video, EncodesFramesWhenFfmpegIsInstalled) {
-  if (!find_on_path("ffmpeg")) GTEST_SKIP() << "ffmpeg is not installed here; the missing case is tested above";
+  if (!find_on_path("ffmpeg"))
+    GTEST_SKIP() << "ffmpeg is not installed here; the missing case is tested above";
   test::TempDir dir("video_enc");
   const auto p = make_scene<2>({{Vec<2, double>{{0.5, 0.5}}, 0}});
   RenderOptions o = bare(161, 91);  // odd sizes must be padded for yuv420p
-  for (int f = 0; f < 3; ++f) render_png(p, o, RenderBox{}, f * 0.1, dir / ("frame_0000" + std::to_string(f) + ".png"));
+  for (int f = 0; f < 3; ++f)
+    render_png(p, o, RenderBox{}, f * 0.1, dir / ("frame_0000" + std::to_string(f) + ".png"));
   const auto r = make_mp4(dir.path(), "frame_%05d.png", 10, dir / "out.mp4");
   EXPECT_TRUE(r.ok) << r.message;
   EXPECT_GT(std::filesystem::file_size(dir / "out.mp4"), 100u);
