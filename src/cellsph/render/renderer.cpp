@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
 #include "cellsph/render/bitmap_font.hpp"
 
 namespace cellsph {
@@ -92,42 +93,71 @@ struct FrameBuffer {
   }
 };
 
+// A sprite placed on the screen.
+struct Placed {
+  double sx, sy, rp, depth, radius;
+  Rgb8 colour;
+  int y0, y1;  // rows covered
+};
+
 // One directional light fixed to the camera (upper left, in front), Lambert plus a Blinn highlight.
+// Sprites are drawn front to back (fewer shaded pixels that a nearer one would overwrite) and the frame
+// is cut into bands of rows shaded in parallel; every pixel sees the sprites in the same order whatever
+// the thread count, so the image is deterministic.
 void shade_sprites(FrameBuffer& fb, const View& view, const std::vector<Sprite>& sprites) {
-  const V3 light = normalized({-0.45, 0.65, -0.6});
-  const V3 half = normalized(light + V3{0, 0, -1});
+  std::vector<Placed> placed;
+  placed.reserve(sprites.size());
   for (const auto& s : sprites) {
     const V3 c = view.to_view(s.centre);
     double sx, sy;
     if (!view.project(c, sx, sy)) continue;
     const double rp = std::max(0.75, view.pixel_radius(s.radius, c.z));
-    const int x0 = std::max(0, static_cast<int>(std::floor(sx - rp)));
-    const int x1 = std::min(fb.w - 1, static_cast<int>(std::ceil(sx + rp)));
+    if (sx + rp < 0 || sx - rp > fb.w || sy + rp < 0 || sy - rp > fb.h) continue;
     const int y0 = std::max(0, static_cast<int>(std::floor(sy - rp)));
     const int y1 = std::min(fb.h - 1, static_cast<int>(std::ceil(sy + rp)));
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        const double dx = (x + 0.5 - sx) / rp;
-        const double dy = (sy - (y + 0.5)) / rp;
-        const double q = dx * dx + dy * dy;
-        if (q > 1) continue;
-        const double nz = std::sqrt(1 - q);
-        // Depth of the sphere's front surface at this pixel: the impostor behaves like a real sphere
-        // where particles overlap.
-        const auto d = static_cast<float>(c.z - s.radius * nz);
-        const std::size_t idx = static_cast<std::size_t>(y) * fb.w + x;
-        if (!(d < fb.depth[idx])) continue;
-        fb.depth[idx] = d;
-        const V3 n{dx, dy, -nz};
-        const double diffuse = std::max(0.0, dot(n, light));
-        const double spec = std::pow(std::max(0.0, dot(n, half)), 40.0);
-        for (int k = 0; k < 3; ++k) {
-          const double v = s.colour[k] * (0.3 + 0.7 * diffuse) + 90.0 * spec;
-          fb.rgb[3 * idx + k] = static_cast<float>(std::min(255.0, v));
+    placed.push_back({sx, sy, rp, c.z, s.radius, s.colour, y0, y1});
+  }
+  std::stable_sort(placed.begin(), placed.end(),
+                   [](const Placed& a, const Placed& b) { return a.depth < b.depth; });
+
+  const V3 light = normalized({-0.45, 0.65, -0.6});
+  const V3 half = normalized(light + V3{0, 0, -1});
+  constexpr int band = 32;
+  const auto bands = static_cast<std::size_t>((fb.h + band - 1) / band);
+  parallel_chunks(bands, 1, [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t bi = b0; bi < b1; ++bi) {
+      const int row0 = static_cast<int>(bi) * band, row1 = std::min(fb.h - 1, row0 + band - 1);
+      for (const auto& s : placed) {
+        if (s.y1 < row0 || s.y0 > row1) continue;
+        const int x0 = std::max(0, static_cast<int>(std::floor(s.sx - s.rp)));
+        const int x1 = std::min(fb.w - 1, static_cast<int>(std::ceil(s.sx + s.rp)));
+        const double inv = 1 / s.rp;
+        for (int y = std::max(row0, s.y0); y <= std::min(row1, s.y1); ++y) {
+          const double dy = (s.sy - (y + 0.5)) * inv;
+          for (int x = x0; x <= x1; ++x) {
+            const double dx = (x + 0.5 - s.sx) * inv;
+            const double q = dx * dx + dy * dy;
+            if (q > 1) continue;
+            const double nz = std::sqrt(1 - q);
+            // Depth of the sphere's front surface at this pixel: the impostor behaves like a real
+            // sphere where particles overlap.
+            const auto d = static_cast<float>(s.depth - s.radius * nz);
+            const std::size_t idx = static_cast<std::size_t>(y) * fb.w + x;
+            if (!(d < fb.depth[idx])) continue;
+            fb.depth[idx] = d;
+            const V3 n{dx, dy, -nz};
+            const double diffuse = std::max(0.0, dot(n, light));
+            const double h1 = std::max(0.0, dot(n, half)), h2 = h1 * h1, h4 = h2 * h2, h8 = h4 * h4;
+            const double spec = h8 * h8 * h8 * h8 * h8;  // exponent 40
+            for (int k = 0; k < 3; ++k) {
+              const double v = s.colour[k] * (0.3 + 0.7 * diffuse) + 90.0 * spec;
+              fb.rgb[3 * idx + k] = static_cast<float>(std::min(255.0, v));
+            }
+          }
         }
       }
     }
-  }
+  });
 }
 
 // A world-space segment, `thickness` pixels wide; depth-tested unless depth_test is false.
@@ -167,7 +197,8 @@ void draw_segment(FrameBuffer& fb, const View& view, V3 a, V3 b, double thicknes
 Image downsample(const FrameBuffer& fb, int ss) {
   Image img(fb.w / ss, fb.h / ss);
   const double inv = 1.0 / (ss * ss);
-  for (int y = 0; y < img.height; ++y)
+  parallel_for(static_cast<std::size_t>(img.height), [&](std::size_t row) {
+    const int y = static_cast<int>(row);
     for (int x = 0; x < img.width; ++x) {
       double acc[3] = {0, 0, 0};
       for (int j = 0; j < ss; ++j)
@@ -180,6 +211,7 @@ Image downsample(const FrameBuffer& fb, int ss) {
                static_cast<std::uint8_t>(std::lround(std::clamp(acc[1] * inv, 0.0, 255.0))),
                static_cast<std::uint8_t>(std::lround(std::clamp(acc[2] * inv, 0.0, 255.0)))});
     }
+  });
   return img;
 }
 

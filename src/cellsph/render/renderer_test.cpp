@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
 #include "cellsph/io/io_test_util.hpp"
 #include "cellsph/render/bitmap_font.hpp"
 #include "cellsph/render/video.hpp"
@@ -234,6 +235,26 @@ TEST(Renderer, PngIsDecodableDeterministicAndAtomic) {
   EXPECT_EQ(test::slurp(dir / "g.png"), bytes);
   EXPECT_EQ(dir.listing(), (std::vector<std::string>{"f.png", "g.png"}));
   EXPECT_THROW(read_png(dir / "missing.png"), InputError);
+}
+
+TEST(Renderer, SameImageForAnyThreadCount) {
+  std::vector<std::pair<Vec<3, double>, int>> spec;
+  for (int i = 0; i < 400; ++i)
+    spec.push_back(
+        {Vec<3, double>{{0.05 + 0.002 * i, 0.5 + 0.3 * std::sin(i * 0.1), 0.3 + 0.001 * i}}, i % 3});
+  const auto p = make_scene<3>(spec);
+  RenderOptions o = bare(320, 240);
+  o.particle_radius = 0.04;
+  Image one, two;
+  {
+    ScopedThreads t(1);
+    one = render_image(p, o, RenderBox{}, 0.0);
+  }
+  {
+    ScopedThreads t(2);
+    two = render_image(p, o, RenderBox{}, 0.0);
+  }
+  EXPECT_EQ(one.rgb, two.rgb);
 }
 
 TEST(BitmapFont, GlyphsAndText) {
