@@ -176,7 +176,7 @@ void write_checkpoint_any(const P& particles, const CheckpointInfo& info, const 
     put_string(out, name, true);
     put(out, static_cast<std::uint32_t>(sizeof(T)));
     put(out, static_cast<std::uint64_t>(field.size()));
-    out.append(reinterpret_cast<const char*>(field.data()), field.size() * sizeof(T));
+    if (!field.empty()) out.append(reinterpret_cast<const char*>(field.data()), field.size() * sizeof(T));
   });
   put(out, checksum(out.data(), out.size()));
   write_file_atomic(path, out);

@@ -103,6 +103,7 @@ std::string csv_header_any() {
 template <class P>
 void write_csv_any(const P& particles, const std::filesystem::path& path, const CsvRowFilter& keep) {
   using namespace io::detail;
+  io::check_field_sizes(particles);
   AtomicFile file(path, true);
   auto& out = file.stream();
   const std::string header = csv_header_any<P>() + "\n";

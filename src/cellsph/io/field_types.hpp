@@ -7,6 +7,7 @@
 #include <string_view>
 #include <type_traits>
 
+#include "cellsph/core/error.hpp"
 #include "cellsph/core/vec.hpp"
 
 namespace cellsph::io {
@@ -30,6 +31,16 @@ struct FieldType<Vec<Dim, Real>> {
 
 template <class Vector>
 using FieldOf = FieldType<typename std::remove_cvref_t<Vector>::value_type>;
+
+// Every field must hold one element per particle; a writer indexing a shorter one would read past it.
+template <class P>
+void check_field_sizes(const P& particles) {
+  particles.for_each_field([&](std::string_view name, const auto& field) {
+    CELLSPH_CHECK(field.size() == particles.size(), "particle field '" << name << "' has " << field.size()
+                                                                       << " elements for " << particles.size()
+                                                                       << " particles");
+  });
+}
 
 // VTK XML type name of a scalar type ("Float32", "Int32", ...).
 template <class S>

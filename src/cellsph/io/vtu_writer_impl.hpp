@@ -35,7 +35,7 @@ void write_block(std::ostream& out, const Vector& field) {
   if constexpr (FT::components == nc) {
     // Vec<3,Real> and scalars are already laid out as VTK wants them.
     static_assert(sizeof(typename Vector::value_type) == nc * sizeof(S));
-    out.write(reinterpret_cast<const char*>(field.data()), static_cast<std::streamsize>(bytes));
+    if (bytes) out.write(reinterpret_cast<const char*>(field.data()), static_cast<std::streamsize>(bytes));
   } else {
     constexpr std::size_t chunk = 4096;
     std::vector<S> buf;
@@ -107,6 +107,7 @@ inline std::string xml_escape(std::string_view s) {
 template <class P>
 void write_vtu_any(const P& particles, double time, const std::filesystem::path& path) {
   using namespace io::detail;
+  io::check_field_sizes(particles);
   const std::size_t n = particles.size();
   const std::vector<double> time_value{time};
   // Vertex cells: cell i is point i. Int64 so any particle count fits.

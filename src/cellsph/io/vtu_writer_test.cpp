@@ -42,7 +42,7 @@ struct ParsedVtu {
     std::memcpy(&n, bytes.data() + data_start + a.offset, 8);
     if (byte_count) *byte_count = n;
     std::vector<T> v(n / sizeof(T));
-    std::memcpy(v.data(), bytes.data() + data_start + a.offset + 8, n);
+    if (n) std::memcpy(v.data(), bytes.data() + data_start + a.offset + 8, n);
     return v;
   }
 };
@@ -194,6 +194,14 @@ TEST(VtuWriter, ReplacesTargetAndLeavesNoTemporaryFile) {
 TEST(VtuWriter, UnwritableFolderIsAnInputError) {
   test::TempDir dir("vtu_bad");
   EXPECT_THROW(write_vtu(test::make_particles<2, float>(3), 0.5, dir / "missing" / "f.vtu"), InputError);
+  EXPECT_TRUE(dir.listing().empty());
+}
+
+TEST(VtuWriter, InconsistentFieldLengthsAreRefusedBeforeWriting) {
+  test::TempDir dir("vtu_sizes");
+  auto p = test::make_particles<3, double>(4);
+  p.level.pop_back();
+  EXPECT_THROW(write_vtu(p, 0.0, dir / "f.vtu"), std::logic_error);
   EXPECT_TRUE(dir.listing().empty());
 }
 

@@ -409,6 +409,9 @@ Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const 
 
   // The scalar to colour by, and its range.
   const auto n = p.size();
+  CELLSPH_CHECK(p.v.size() == n && p.p.size() == n && p.m.size() == n && p.rho.size() == n &&
+                    p.h.size() == n && p.phase.size() == n,
+                "particle fields of unequal length");
   auto value = [&](std::size_t i) -> double {
     if (o.color_by == ColorBy::Speed) return std::sqrt(static_cast<double>(norm2(p.v[i])));
     if (o.color_by == ColorBy::Pressure) return static_cast<double>(p.p[i]);
