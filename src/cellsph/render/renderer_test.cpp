@@ -297,6 +297,9 @@ TEST(Video, EncodesFramesWhenFfmpegIsInstalled) {
   const auto r = make_mp4(dir.path(), "frame_%05d.png", 10, dir / "out.mp4");
   EXPECT_TRUE(r.ok) << r.message;
   EXPECT_GT(std::filesystem::file_size(dir / "out.mp4"), 100u);
+  EXPECT_EQ(test::slurp(dir / "out.mp4").substr(4, 4), "ftyp");  // an ISO media file
+  EXPECT_EQ(dir.listing(), (std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png",
+                                                     "out.mp4"}));
 }
 
 }  // namespace
