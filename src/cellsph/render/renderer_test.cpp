@@ -257,6 +257,23 @@ TEST(Renderer, SameImageForAnyThreadCount) {
   EXPECT_EQ(one.rgb, two.rgb);
 }
 
+TEST(Image, IncompressibleImageRoundTripsThroughPng) {
+  // Noise compresses worse than the first buffer guess, so the encoder's second pass is exercised.
+  test::TempDir dir("png_noise");
+  Image img(64, 48);
+  std::uint32_t state = 12345;
+  for (auto& b : img.rgb) {
+    state = state * 1664525u + 1013904223u;
+    b = static_cast<std::uint8_t>(state >> 24);
+  }
+  write_png(img, dir / "n.png");
+  const Image back = read_png(dir / "n.png");
+  EXPECT_EQ(back.width, 64);
+  EXPECT_EQ(back.height, 48);
+  EXPECT_EQ(back.rgb, img.rgb);
+  EXPECT_GT(std::filesystem::file_size(dir / "n.png"), img.rgb.size() / 2 + 4096);
+}
+
 TEST(BitmapFont, GlyphsAndText) {
   // '.' is the 2x2 block at the bottom left-centre.
   int dots = 0;
@@ -298,8 +315,8 @@ TEST(Video, EncodesFramesWhenFfmpegIsInstalled) {
   EXPECT_TRUE(r.ok) << r.message;
   EXPECT_GT(std::filesystem::file_size(dir / "out.mp4"), 100u);
   EXPECT_EQ(test::slurp(dir / "out.mp4").substr(4, 4), "ftyp");  // an ISO media file
-  EXPECT_EQ(dir.listing(), (std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png",
-                                                     "out.mp4"}));
+  EXPECT_EQ(dir.listing(),
+            (std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png", "out.mp4"}));
 }
 
 }  // namespace
