@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
+#include <sstream>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/io/io_test_util.hpp"
@@ -203,6 +206,56 @@ TEST(VtuWriter, InconsistentFieldLengthsAreRefusedBeforeWriting) {
   p.level.pop_back();
   EXPECT_THROW(write_vtu(p, 0.0, dir / "f.vtu"), std::logic_error);
   EXPECT_TRUE(dir.listing().empty());
+}
+
+// The real consumer: VTK's own XML reader (ParaView's), through Debian's python3-vtk9 when installed.
+TEST(VtuWriter, ReadBackByVtkWhenInstalled) {
+  if (std::system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-vtk9 is not installed; the independent parser above still checks the format";
+  test::TempDir dir("vtu_vtk");
+  const auto p = test::make_particles<2, float>(6);
+  write_vtu(p, 0.75, dir / "f.vtu");
+  test::spit(dir / "read.py",
+             "import sys, vtk\n"
+             "r = vtk.vtkXMLUnstructuredGridReader()\n"
+             "r.SetFileName(sys.argv[1])\n"
+             "r.Update()\n"
+             "g = r.GetOutput()\n"
+             "pd = g.GetPointData()\n"
+             "print(g.GetNumberOfPoints(), g.GetNumberOfCells(), g.GetCellType(0))\n"
+             "print(g.GetFieldData().GetArray('TimeValue').GetValue(0))\n"
+             "print(repr(g.GetPoint(4)))\n"
+             "print(pd.GetArray('density').GetValue(4), pd.GetArray('phase').GetValue(4), "
+             "pd.GetArray('velocity').GetNumberOfComponents())\n");
+  const auto out = dir / "out.txt";
+  const std::string cmd = "/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "f.vtu").string() +
+                          " > " + out.string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::slurp(out);
+  std::istringstream lines(test::slurp(out));
+  std::string l1, l2, l3, l4;
+  std::getline(lines, l1);
+  std::getline(lines, l2);
+  std::getline(lines, l3);
+  std::getline(lines, l4);
+  EXPECT_EQ(l1, "6 6 1");  // points, cells, VTK_VERTEX
+  EXPECT_EQ(l2, "0.75");
+  // Python prints the float32 values widened to double, shortest repr.
+  auto widened = [](float v) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.17g", static_cast<double>(v));
+    return std::stod(buf);
+  };
+  double x, y, z;
+  ASSERT_EQ(std::sscanf(l3.c_str(), "(%lf, %lf, %lf)", &x, &y, &z), 3) << l3;
+  EXPECT_EQ(x, widened(p.x[4][0]));
+  EXPECT_EQ(y, widened(p.x[4][1]));
+  EXPECT_EQ(z, 0.0);
+  double rho;
+  int phase, comps;
+  ASSERT_EQ(std::sscanf(l4.c_str(), "%lf %d %d", &rho, &phase, &comps), 3) << l4;
+  EXPECT_EQ(rho, widened(p.rho[4]));
+  EXPECT_EQ(phase, p.phase[4]);
+  EXPECT_EQ(comps, 3);
 }
 
 TEST(PvdWriter, ListsEveryFrameWithItsTimeAfterEachAdd) {
