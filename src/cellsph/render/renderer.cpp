@@ -325,9 +325,15 @@ ViewAndScale make_view(int dim, const RenderOptions& o, const RenderBox& box, co
   }
   v.eye = to_v3(cam.position);
   v.fwd = normalized(to_v3(cam.target) - v.eye);
-  CELLSPH_CHECK(dot(v.fwd, v.fwd) > 0, "camera position equals its target");
+  if (!(dot(v.fwd, v.fwd) > 0)) throw InputError("render camera: position equals target");
   v.right = normalized(cross(v.fwd, to_v3(cam.up)));
-  CELLSPH_CHECK(dot(v.right, v.right) > 0, "camera up vector is parallel to the viewing direction");
+  if (!(dot(v.right, v.right) > 0))
+    throw InputError("render camera: up vector is zero or parallel to the viewing direction");
+  if (!cam.orthographic && !(cam.fov_y_deg > 0 && cam.fov_y_deg < 180))
+    throw InputError("render camera: field of view " + format("%g", cam.fov_y_deg) +
+                     " degrees is outside (0, 180)");
+  if (cam.orthographic && cam.ortho_height < 0)
+    throw InputError("render camera: orthographic height " + format("%g", cam.ortho_height) + " is negative");
   v.up = cross(v.right, v.fwd);
   v.ortho = cam.orthographic;
   const double target_dist = std::sqrt(dot(to_v3(cam.target) - v.eye, to_v3(cam.target) - v.eye));
@@ -400,9 +406,13 @@ Rgb8 colormap(double t) {
 
 template <int Dim, class Real>
 Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const RenderBox& box, double time) {
-  CELLSPH_CHECK(o.width > 0 && o.height > 0 && o.width <= 16384 && o.height <= 16384,
-                "image size " << o.width << "x" << o.height);
-  CELLSPH_CHECK(o.supersample >= 1 && o.supersample <= 4, "supersample " << o.supersample);
+  if (!(o.width > 0 && o.height > 0 && o.width <= 16384 && o.height <= 16384))
+    throw InputError("render image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                     " is outside 1..16384");
+  if (!(o.supersample >= 1 && o.supersample <= 4))
+    throw InputError("render supersample " + std::to_string(o.supersample) + " is outside 1..4");
+  if (o.up_axis != 1 && o.up_axis != 2)
+    throw InputError("render up axis " + std::to_string(o.up_axis) + " must be 1 (y) or 2 (z)");
   const int ss = o.supersample;
   const Layout layout = make_layout(o);
   const ViewAndScale vs = make_view(Dim, o, box, layout);

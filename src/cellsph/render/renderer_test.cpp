@@ -237,6 +237,20 @@ TEST(Renderer, PngIsDecodableDeterministicAndAtomic) {
   EXPECT_THROW(read_png(dir / "missing.png"), InputError);
 }
 
+TEST(Renderer, BadOptionsAreInputErrors) {
+  const auto p = make_scene<3>({{Vec<3, double>{{0.5, 0.5, 0.5}}, 0}});
+  RenderOptions o = bare(64, 48);
+  o.camera = Camera{{1, 1, 1}, {1, 1, 1}, {0, 1, 0}, 35, false, 0};
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+  o.camera = Camera{{0, 0, 5}, {0, 0, 0}, {0, 0, 1}, 35, false, 0};  // up along the view
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+  o.camera = Camera{{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 180, false, 0};
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+  o.camera.reset();
+  o.width = 0;
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+}
+
 TEST(Renderer, SameImageForAnyThreadCount) {
   std::vector<std::pair<Vec<3, double>, int>> spec;
   for (int i = 0; i < 400; ++i)
