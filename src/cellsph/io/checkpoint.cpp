@@ -1,252 +1,32 @@
 #include "cellsph/io/checkpoint.hpp"
 
-#include <algorithm>
-#include <bit>
-#include <cstring>
-#include <fstream>
-#include <set>
-#include <string_view>
-#include <type_traits>
-#include <vector>
-
-#include "cellsph/core/atomic_file.hpp"
-#include "cellsph/core/error.hpp"
+#include "cellsph/io/checkpoint_impl.hpp"
 
 namespace cellsph {
-
-static_assert(std::endian::native == std::endian::little, "checkpoints are written little endian");
-
-namespace {
-
-constexpr char kMagic[8] = {'C', 'S', 'P', 'H', 'C', 'K', 'P', 'T'};
-constexpr std::uint32_t kByteOrderMark = 0x01020304u;
-
-// FNV-1a over 64-bit words (the tail zero-padded): 8x fewer dependent multiplies than the byte-wise
-// hash, enough to detect a corrupted or half-written file.
-std::uint64_t checksum(const char* data, std::size_t n) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  constexpr std::uint64_t prime = 0x100000001b3ull;
-  std::size_t i = 0;
-  for (; i + 8 <= n; i += 8) {
-    std::uint64_t w;
-    std::memcpy(&w, data + i, 8);
-    h = (h ^ w) * prime;
-  }
-  if (i < n) {
-    std::uint64_t w = 0;
-    std::memcpy(&w, data + i, n - i);
-    h = (h ^ w) * prime;
-  }
-  return (h ^ n) * prime;
-}
-
-template <class T>
-void put(std::string& out, const T& v) {
-  static_assert(std::is_trivially_copyable_v<T>);
-  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-
-void put_string(std::string& out, std::string_view s, bool short_len) {
-  if (short_len) put(out, static_cast<std::uint32_t>(s.size()));
-  else put(out, static_cast<std::uint64_t>(s.size()));
-  out.append(s);
-}
-
-// Bounds-checked reader over the file's bytes; every failure names the file and what was read.
-class Cursor {
- public:
-  Cursor(const std::filesystem::path& path, const std::string& bytes, std::size_t end)
-      : path_(path), bytes_(bytes), end_(end) {}
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InputError("checkpoint '" + path_.string() + "': " + what);
-  }
-  void need(std::size_t n, std::string_view what) const {
-    if (n > end_ - pos_)
-      fail("truncated: file ends at byte " + std::to_string(end_) + " while reading " + std::string(what) +
-           " (needs " + std::to_string(n) + " bytes at byte " + std::to_string(pos_) + ")");
-  }
-  template <class T>
-  T get(std::string_view what) {
-    need(sizeof(T), what);
-    T v;
-    std::memcpy(&v, bytes_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return v;
-  }
-  std::string_view get_bytes(std::size_t n, std::string_view what) {
-    need(n, what);
-    std::string_view s(bytes_.data() + pos_, n);
-    pos_ += n;
-    return s;
-  }
-  [[nodiscard]] std::string_view peek(std::size_t n) const {
-    return {bytes_.data() + pos_, std::min(n, end_ - pos_)};
-  }
-  [[nodiscard]] std::size_t pos() const { return pos_; }
-
- private:
-  const std::filesystem::path& path_;
-  const std::string& bytes_;
-  std::size_t end_;
-  std::size_t pos_ = 0;
-};
-
-std::string read_all(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot read checkpoint '" + path.string() + "'");
-  std::string bytes;
-  in.seekg(0, std::ios::end);
-  const auto size = in.tellg();
-  if (size < 0) throw InputError("cannot read checkpoint '" + path.string() + "'");
-  bytes.resize(static_cast<std::size_t>(size));
-  in.seekg(0);
-  in.read(bytes.data(), size);
-  if (!in) throw InputError("error while reading checkpoint '" + path.string() + "'");
-  return bytes;
-}
-
-CheckpointHeader parse_header(Cursor& c) {
-  // A short file that does not even start like a checkpoint is "not a checkpoint", not "truncated".
-  const auto head = c.peek(sizeof(kMagic));
-  if (std::memcmp(head.data(), kMagic, head.size()) != 0) c.fail("bad magic number: not a cellsph checkpoint");
-  const auto magic = c.get_bytes(sizeof(kMagic), "the magic number");
-  if (std::memcmp(magic.data(), kMagic, sizeof(kMagic)) != 0) c.fail("bad magic number: not a cellsph checkpoint");
-  CheckpointHeader h;
-  h.version = c.get<std::uint32_t>("the format version");
-  if (h.version != kCheckpointVersion)
-    c.fail("format version " + std::to_string(h.version) + " is not supported (this build reads version " +
-           std::to_string(kCheckpointVersion) + ")");
-  if (c.get<std::uint32_t>("the byte-order mark") != kByteOrderMark)
-    c.fail("byte-order mark mismatch (written on a machine of other endianness, or corrupted)");
-  h.dim = static_cast<int>(c.get<std::uint32_t>("the dimension"));
-  h.real_size = static_cast<int>(c.get<std::uint32_t>("the precision"));
-  h.count = c.get<std::uint64_t>("the particle count");
-  h.time = c.get<double>("the simulated time");
-  h.step = c.get<std::uint64_t>("the step count");
-  return h;
-}
-
-const char* precision_name(int size) { return size == 4 ? "float" : size == 8 ? "double" : "unknown"; }
-
-}  // namespace
-
-template <int Dim, class Real>
-void write_checkpoint(const Particles<Dim, Real>& particles, const CheckpointInfo& info,
-                      const std::filesystem::path& path) {
-  std::string out;
-  std::size_t bytes = 256 + info.user.size();
-  particles.for_each_field([&](std::string_view name, const auto& field) {
-    bytes += 16 + name.size() + field.size() * sizeof(field[0]);
-  });
-  out.reserve(bytes);
-  out.append(kMagic, sizeof(kMagic));
-  put(out, kCheckpointVersion);
-  put(out, kByteOrderMark);
-  put(out, static_cast<std::uint32_t>(Dim));
-  put(out, static_cast<std::uint32_t>(sizeof(Real)));
-  put(out, static_cast<std::uint64_t>(particles.size()));
-  put(out, info.time);
-  put(out, info.step);
-  put_string(out, info.user, false);
-  std::uint32_t nfields = 0;
-  particles.for_each_field([&](std::string_view, const auto&) { ++nfields; });
-  put(out, nfields);
-  particles.for_each_field([&](std::string_view name, const auto& field) {
-    using T = typename std::remove_cvref_t<decltype(field)>::value_type;
-    static_assert(std::is_trivially_copyable_v<T>, "checkpointed fields must be trivially copyable");
-    CELLSPH_CHECK(field.size() == particles.size(), "field '" << name << "' has " << field.size()
-                                                              << " elements for " << particles.size() << " particles");
-    put_string(out, name, true);
-    put(out, static_cast<std::uint32_t>(sizeof(T)));
-    put(out, static_cast<std::uint64_t>(field.size()));
-    out.append(reinterpret_cast<const char*>(field.data()), field.size() * sizeof(T));
-  });
-  put(out, checksum(out.data(), out.size()));
-  write_file_atomic(path, out);
-}
 
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("cannot read checkpoint '" + path.string() + "'");
   std::string bytes(64, '\0');
   in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  Cursor c(path, bytes, static_cast<std::size_t>(in.gcount()));
-  return parse_header(c);
+  io::detail::Cursor c(path, bytes, static_cast<std::size_t>(in.gcount()));
+  return io::detail::parse_header(c);
+}
+
+template <int Dim, class Real>
+void write_checkpoint(const Particles<Dim, Real>& particles, const CheckpointInfo& info,
+                      const std::filesystem::path& path) {
+  write_checkpoint_any(particles, info, path);
 }
 
 template <int Dim, class Real>
 CheckpointInfo read_checkpoint(const std::filesystem::path& path, Particles<Dim, Real>& particles) {
-  const std::string bytes = read_all(path);
-  if (bytes.size() < sizeof(std::uint64_t) + sizeof(kMagic)) {
-    Cursor c(path, bytes, bytes.size());
-    parse_header(c);  // reports bad magic or truncation
-  }
-  // The checksum is the last 8 bytes: everything before it is the body.
-  const std::size_t body = bytes.size() - sizeof(std::uint64_t);
-  Cursor c(path, bytes, body);
-  const CheckpointHeader h = parse_header(c);
-  if (h.dim != Dim)
-    c.fail("written by a " + std::to_string(h.dim) + "D run, cannot continue a " + std::to_string(Dim) + "D run");
-  if (h.real_size != static_cast<int>(sizeof(Real)))
-    c.fail(std::string("precision mismatch: file holds ") + precision_name(h.real_size) + " (" +
-           std::to_string(h.real_size) + " bytes), this run uses " + precision_name(sizeof(Real)));
-  CheckpointInfo info;
-  info.time = h.time;
-  info.step = h.step;
-  const auto user_len = c.get<std::uint64_t>("the user data length");
-  info.user = std::string(c.get_bytes(user_len, "the user data"));
-
-  // Before allocating: a corrupt count must not ask for more memory than the file could fill.
-  std::size_t per_particle = 0;
-  particles.for_each_field([&](std::string_view, const auto& field) { per_particle += sizeof(field[0]); });
-  if (per_particle && h.count > (body - c.pos()) / per_particle)
-    c.fail("truncated or corrupt: " + std::to_string(h.count) + " particles need more bytes than the file has");
-  Particles<Dim, Real> loaded;
-  loaded.resize(static_cast<std::size_t>(h.count));
-  std::set<std::string, std::less<>> known, seen;
-  loaded.for_each_field([&](std::string_view name, const auto&) { known.emplace(name); });
-  const auto nfields = c.get<std::uint32_t>("the field count");
-  for (std::uint32_t fi = 0; fi < nfields; ++fi) {
-    const auto what = "field " + std::to_string(fi + 1) + " of " + std::to_string(nfields);
-    const auto name_len = c.get<std::uint32_t>(what + " (name length)");
-    const std::string name(c.get_bytes(name_len, what + " (name)"));
-    if (!known.count(name)) c.fail("unknown field '" + name + "' (" + what + "); this build does not have it");
-    if (!seen.insert(name).second) c.fail("field '" + name + "' appears twice");
-    const auto elem_size = c.get<std::uint32_t>("the element size of field '" + name + "'");
-    const auto count = c.get<std::uint64_t>("the element count of field '" + name + "'");
-    bool found = false;
-    loaded.for_each_field([&](std::string_view fname, auto& field) {
-      if (fname != name) return;
-      found = true;
-      using T = typename std::remove_cvref_t<decltype(field)>::value_type;
-      if (elem_size != sizeof(T))
-        c.fail("field '" + name + "' has elements of " + std::to_string(elem_size) + " bytes, expected " +
-               std::to_string(sizeof(T)));
-      if (count != h.count)
-        c.fail("field '" + name + "' has " + std::to_string(count) + " elements for " + std::to_string(h.count) +
-               " particles");
-      if (count > (body - c.pos()) / sizeof(T))  // checked by division: a corrupt count must not overflow
-        c.fail("truncated: file ends at byte " + std::to_string(body) + " inside the data of field '" + name + "'");
-      const auto data = c.get_bytes(static_cast<std::size_t>(count) * sizeof(T), "the data of field '" + name + "'");
-      if (count) std::memcpy(field.data(), data.data(), data.size());
-    });
-    CELLSPH_CHECK(found, name);
-  }
-  for (const auto& name : known)
-    if (!seen.count(name)) c.fail("missing field '" + name + "'");
-  if (c.pos() != body)
-    c.fail(std::to_string(body - c.pos()) + " unexpected bytes after the last field (corrupted or wrong format)");
-  std::uint64_t stored;
-  std::memcpy(&stored, bytes.data() + body, sizeof(stored));
-  if (stored != checksum(bytes.data(), body)) c.fail("checksum mismatch: the file is corrupted");
-  particles = std::move(loaded);
-  return info;
+  return read_checkpoint_any(path, particles);
 }
 
-#define CELLSPH_CHECKPOINT_INSTANTIATE(D, R)                                                               \
-  template void write_checkpoint<D, R>(const Particles<D, R>&, const CheckpointInfo&,                      \
-                                       const std::filesystem::path&);                                      \
+#define CELLSPH_CHECKPOINT_INSTANTIATE(D, R)                                          \
+  template void write_checkpoint<D, R>(const Particles<D, R>&, const CheckpointInfo&, \
+                                       const std::filesystem::path&);                 \
   template CheckpointInfo read_checkpoint<D, R>(const std::filesystem::path&, Particles<D, R>&);
 CELLSPH_CHECKPOINT_INSTANTIATE(2, float)
 CELLSPH_CHECKPOINT_INSTANTIATE(2, double)

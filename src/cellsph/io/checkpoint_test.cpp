@@ -53,8 +53,12 @@ void check_round_trip() {
   EXPECT_TRUE(same_bits(q.level, p.level));
 }
 
-TEST(Checkpoint, RoundTripIsBitExact2DFloat) { check_round_trip<2, float>(); }
-TEST(Checkpoint, RoundTripIsBitExact3DDouble) { check_round_trip<3, double>(); }
+TEST(Checkpoint, RoundTripIsBitExact2DFloat) {
+  check_round_trip<2, float>();
+}
+TEST(Checkpoint, RoundTripIsBitExact3DDouble) {
+  check_round_trip<3, double>();
+}
 
 TEST(Checkpoint, EmptyParticleSet) {
   test::TempDir dir("ckpt_empty");
@@ -96,7 +100,9 @@ class CheckpointErrors : public ::testing::Test {
   std::string good_;
 };
 
-TEST_F(CheckpointErrors, GoodFileLoads) { EXPECT_EQ(load_error(dir_ / "good.ckpt"), "no error"); }
+TEST_F(CheckpointErrors, GoodFileLoads) {
+  EXPECT_EQ(load_error(dir_ / "good.ckpt"), "no error");
+}
 
 TEST_F(CheckpointErrors, BadMagic) {
   EXPECT_NE(with([](std::string& b) { b[0] = 'X'; }).find("bad magic"), std::string::npos);
@@ -117,8 +123,8 @@ TEST_F(CheckpointErrors, DimensionAndPrecisionMismatch) {
 }
 
 TEST_F(CheckpointErrors, TruncatedAnywhere) {
-  for (std::size_t keep : {std::size_t{3}, std::size_t{20}, std::size_t{60}, good_.size() / 2, good_.size() - 9,
-                           good_.size() - 1}) {
+  for (std::size_t keep : {std::size_t{3}, std::size_t{20}, std::size_t{60}, good_.size() / 2,
+                           good_.size() - 9, good_.size() - 1}) {
     const auto m = with([&](std::string& b) { b.resize(keep); });
     EXPECT_TRUE(m.find("truncated") != std::string::npos || m.find("bad magic") != std::string::npos ||
                 m.find("missing field") != std::string::npos || m.find("checksum") != std::string::npos)

@@ -31,8 +31,9 @@ T parse(const std::string& s) {
 TEST(CsvWriter, HeaderStartsWithTheContractColumns) {
   EXPECT_EQ((csv_header<2, double>()),
             "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level");
-  EXPECT_EQ((csv_header<3, float>()),
-            "x,y,z,vx,vy,vz,density,pressure,phase,force_x,force_y,force_z,mass,support,color,viscosity,level");
+  EXPECT_EQ(
+      (csv_header<3, float>()),
+      "x,y,z,vx,vy,vz,density,pressure,phase,force_x,force_y,force_z,mass,support,color,viscosity,level");
 }
 
 template <int Dim, class Real>
@@ -71,8 +72,12 @@ void check_round_trip() {
   EXPECT_EQ(i, n);
 }
 
-TEST(CsvWriter, RoundTripsBitExactly2DDouble) { check_round_trip<2, double>(); }
-TEST(CsvWriter, RoundTripsBitExactly3DFloat) { check_round_trip<3, float>(); }
+TEST(CsvWriter, RoundTripsBitExactly2DDouble) {
+  check_round_trip<2, double>();
+}
+TEST(CsvWriter, RoundTripsBitExactly3DFloat) {
+  check_round_trip<3, float>();
+}
 
 TEST(CsvWriter, FilterKeepsOnlySelectedRowsInOrder) {
   test::TempDir dir("csv_filter");

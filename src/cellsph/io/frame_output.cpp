@@ -30,8 +30,8 @@ void FrameOutput<Dim, Real>::resume(std::size_t next_frame) {
       std::string have, want;
       for (const auto& f : old.formats()) have += (have.empty() ? "" : ",") + f;
       for (const auto& f : index_.formats()) want += (want.empty() ? "" : ",") + f;
-      throw InputError(std::string("'") + index_path.string() + "' lists formats '" + have + "' but this run writes '" + want +
-                       "'");
+      throw InputError(std::string("'") + index_path.string() + "' lists formats '" + have +
+                       "' but this run writes '" + want + "'");
     }
     for (const auto& r : old.rows())
       if (r.frame < next_frame) rows.push_back(r);

@@ -26,7 +26,8 @@ class FrameOutput {
   void resume(std::size_t next_frame);
 
   // Writes frame number `frame` at simulated time `time`; returns the files written (absolute).
-  std::vector<std::filesystem::path> write(const Particles<Dim, Real>& particles, std::size_t frame, double time);
+  std::vector<std::filesystem::path> write(const Particles<Dim, Real>& particles, std::size_t frame,
+                                           double time);
 
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
   [[nodiscard]] const FramesIndex& index() const { return index_; }

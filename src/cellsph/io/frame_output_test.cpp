@@ -17,7 +17,8 @@ TEST(FrameOutput, WritesEveryFormatThenTheIndexes) {
   EXPECT_EQ(files.size(), 3u);
   const test::TempDir& d = dir;
   std::vector<std::string> names;
-  for (const auto& e : std::filesystem::directory_iterator(d.path() / "run")) names.push_back(e.path().filename());
+  for (const auto& e : std::filesystem::directory_iterator(d.path() / "run"))
+    names.push_back(e.path().filename());
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"frame_00000.csv", "frame_00000.ply", "frame_00000.vtu",
                                              "frame_00001.csv", "frame_00001.ply", "frame_00001.vtu",

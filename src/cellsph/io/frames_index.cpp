@@ -41,7 +41,8 @@ OutputFormats parse_output_formats(std::string_view list, std::string_view what)
     if (!flag)
       throw InputError(std::string(what) + ": unknown output format '" + std::string(item) +
                        "' (expected a comma-separated subset of vtu,ply,csv)");
-    if (*flag) throw InputError(std::string(what) + ": output format '" + std::string(item) + "' given twice");
+    if (*flag)
+      throw InputError(std::string(what) + ": output format '" + std::string(item) + "' given twice");
     *flag = true;
   }
   return f;
@@ -57,21 +58,25 @@ std::string frame_file_name(std::size_t frame, std::string_view extension, std::
   return name;
 }
 
-FramesIndex::FramesIndex(std::filesystem::path path, std::vector<std::string> formats, std::vector<FrameRow> rows)
+FramesIndex::FramesIndex(std::filesystem::path path, std::vector<std::string> formats,
+                         std::vector<FrameRow> rows)
     : path_(std::move(path)), formats_(std::move(formats)), rows_(std::move(rows)) {
   // Keep the contract: known formats, canonical order.
   std::size_t next = 0;
   for (const auto& f : formats_) {
     while (next < std::size(kFormatOrder) && kFormatOrder[next] != f) ++next;
-    CELLSPH_CHECK(next < std::size(kFormatOrder), "frames.csv format columns must be a subset of vtu,ply,csv in "
-                                                  "that order, got '" << f << "'");
+    CELLSPH_CHECK(next < std::size(kFormatOrder),
+                  "frames.csv format columns must be a subset of vtu,ply,csv in "
+                  "that order, got '"
+                      << f << "'");
     ++next;
   }
 }
 
 void FramesIndex::add(FrameRow row) {
-  CELLSPH_CHECK(row.files.size() == formats_.size(),
-                "frame " << row.frame << " has " << row.files.size() << " files for " << formats_.size() << " formats");
+  CELLSPH_CHECK(row.files.size() == formats_.size(), "frame " << row.frame << " has " << row.files.size()
+                                                              << " files for " << formats_.size()
+                                                              << " formats");
   rows_.push_back(std::move(row));
   write();
 }
@@ -94,17 +99,20 @@ FramesIndex read_frames_index(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError("cannot read frame index '" + path.string() + "'");
   std::string line;
-  if (!std::getline(in, line)) throw InputError(std::string("'") + path.string() + "': empty file, expected header 'frame,time,...'");
+  if (!std::getline(in, line))
+    throw InputError(std::string("'") + path.string() + "': empty file, expected header 'frame,time,...'");
   const auto head = split(line, ',');
   if (head.size() < 2 || head[0] != "frame" || head[1] != "time")
-    throw InputError(std::string("'") + path.string() + "' row 1: header must start with 'frame,time', got '" + line + "'");
+    throw InputError(std::string("'") + path.string() +
+                     "' row 1: header must start with 'frame,time', got '" + line + "'");
   std::vector<std::string> formats;
   std::size_t next = 0;
   for (std::size_t c = 2; c < head.size(); ++c) {
     while (next < std::size(kFormatOrder) && kFormatOrder[next] != head[c]) ++next;
     if (next == std::size(kFormatOrder))
-      throw InputError(std::string("'") + path.string() + "' row 1 column " + std::to_string(c + 1) + ": unexpected column '" +
-                       std::string(head[c]) + "' (format columns are vtu, ply, csv in that order)");
+      throw InputError(std::string("'") + path.string() + "' row 1 column " + std::to_string(c + 1) +
+                       ": unexpected column '" + std::string(head[c]) +
+                       "' (format columns are vtu, ply, csv in that order)");
     formats.emplace_back(head[c]);
     ++next;
   }

@@ -41,8 +41,9 @@ TEST(FramesIndex, RewrittenAfterEachFrameWithTheContractHeader) {
   idx.add({0, 0.0, {"frame_00000.vtu", "frame_00000.csv"}});
   EXPECT_EQ(test::slurp(dir / "frames.csv"), "frame,time,vtu,csv\n0,0,frame_00000.vtu,frame_00000.csv\n");
   idx.add({1, 0.04, {"frame_00001.vtu", "frame_00001.csv"}});
-  EXPECT_EQ(test::slurp(dir / "frames.csv"),
-            "frame,time,vtu,csv\n0,0,frame_00000.vtu,frame_00000.csv\n1,0.04,frame_00001.vtu,frame_00001.csv\n");
+  EXPECT_EQ(
+      test::slurp(dir / "frames.csv"),
+      "frame,time,vtu,csv\n0,0,frame_00000.vtu,frame_00000.csv\n1,0.04,frame_00001.vtu,frame_00001.csv\n");
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"frames.csv"});
 
   const auto back = read_frames_index(dir / "frames.csv");
@@ -67,7 +68,8 @@ TEST(FramesIndex, ReaderNamesFileRowAndColumn) {
   EXPECT_NE(e1.find("a.csv' row 3 column 'time'"), std::string::npos) << e1;
   EXPECT_NE(e1.find("'zero'"), std::string::npos) << e1;
   test::spit(dir / "b.csv", "frame,time,csv,vtu\n");
-  EXPECT_NE(error_of([&] { read_frames_index(dir / "b.csv"); }).find("unexpected column 'vtu'"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_frames_index(dir / "b.csv"); }).find("unexpected column 'vtu'"),
+            std::string::npos);
   test::spit(dir / "c.csv", "time,frame\n");
   EXPECT_NE(error_of([&] { read_frames_index(dir / "c.csv"); }).find("frame,time"), std::string::npos);
   test::spit(dir / "d.csv", "frame,time,ply\n0,0\n");

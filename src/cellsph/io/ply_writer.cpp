@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellsph/core/atomic_file.hpp"
+#include "cellsph/io/field_types.hpp"
 #include "cellsph/io/number_format.hpp"
 
 namespace cellsph {
@@ -16,6 +17,7 @@ static_assert(std::endian::native == std::endian::little, "the PLY writer declar
 
 template <int Dim, class Real>
 void write_ply(const Particles<Dim, Real>& particles, double time, const std::filesystem::path& path) {
+  io::check_field_sizes(particles);
   const std::size_t n = particles.size();
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by cellsph\ncomment time ";
   io::append_number(header, time);

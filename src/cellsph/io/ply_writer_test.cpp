@@ -36,8 +36,8 @@ void check_ply() {
     if (l.rfind("property ", 0) == 0) props.push_back(l.substr(9));
   }
   EXPECT_EQ(count, n);
-  EXPECT_EQ(props, (std::vector<std::string>{"float x", "float y", "float z", "float vx", "float vy", "float vz",
-                                             "float density", "float pressure", "int phase"}));
+  EXPECT_EQ(props, (std::vector<std::string>{"float x", "float y", "float z", "float vx", "float vy",
+                                             "float vz", "float density", "float pressure", "int phase"}));
 
   // Body: n records of 8 floats and one int32, nothing after.
   const char* d = bytes.data() + body + end.size();
@@ -58,8 +58,12 @@ void check_ply() {
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"f.ply"});
 }
 
-TEST(PlyWriter, Binary2DDouble) { check_ply<2, double>(); }
-TEST(PlyWriter, Binary3DFloat) { check_ply<3, float>(); }
+TEST(PlyWriter, Binary2DDouble) {
+  check_ply<2, double>();
+}
+TEST(PlyWriter, Binary3DFloat) {
+  check_ply<3, float>();
+}
 
 }  // namespace
 }  // namespace cellsph

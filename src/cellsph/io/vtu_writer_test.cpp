@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
+#include <sstream>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/io/io_test_util.hpp"
@@ -18,6 +21,7 @@ struct ArrayTag {
   std::string type;
   int components = 0;
   std::uint64_t offset = 0;
+  std::uint64_t tuples = 0;
 };
 
 std::string attr(const std::string& tag, const std::string& key) {
@@ -41,7 +45,7 @@ struct ParsedVtu {
     std::memcpy(&n, bytes.data() + data_start + a.offset, 8);
     if (byte_count) *byte_count = n;
     std::vector<T> v(n / sizeof(T));
-    std::memcpy(v.data(), bytes.data() + data_start + a.offset + 8, n);
+    if (n) std::memcpy(v.data(), bytes.data() + data_start + a.offset + 8, n);
     return v;
   }
 };
@@ -63,7 +67,7 @@ ParsedVtu parse_vtu(const std::filesystem::path& path) {
     if (tag.rfind("<DataArray", 0) == 0) {
       EXPECT_EQ(attr(tag, "format"), "appended") << tag;
       ArrayTag a{section, attr(tag, "type"), std::stoi(attr(tag, "NumberOfComponents")),
-                 std::stoull(attr(tag, "offset"))};
+                 std::stoull(attr(tag, "offset")), std::stoull(attr(tag, "NumberOfTuples"))};
       EXPECT_TRUE(r.arrays.emplace(attr(tag, "Name"), a).second) << "duplicate array " << tag;
     }
   }
@@ -93,10 +97,9 @@ void check_vtu_round_trip() {
   const std::string real = sizeof(Real) == 4 ? "Float32" : "Float64";
   // Every field of the list, written out here by hand, with its VTK type and width.
   const std::map<std::string, std::pair<std::string, int>> expected = {
-      {"velocity", {real, 3}}, {"force", {real, 3}},     {"mass", {real, 1}},
-      {"density", {real, 1}},  {"pressure", {real, 1}},  {"support", {real, 1}},
-      {"color", {real, 1}},    {"viscosity", {real, 1}}, {"phase", {"Int32", 1}},
-      {"level", {"Int32", 1}}};
+      {"velocity", {real, 3}}, {"force", {real, 3}},   {"mass", {real, 1}},  {"density", {real, 1}},
+      {"pressure", {real, 1}}, {"support", {real, 1}}, {"color", {real, 1}}, {"viscosity", {real, 1}},
+      {"phase", {"Int32", 1}}, {"level", {"Int32", 1}}};
   for (const auto& [name, tc] : expected) {
     ASSERT_TRUE(v.arrays.count(name)) << name;
     EXPECT_EQ(v.arrays.at(name).section, "PointData") << name;
@@ -107,6 +110,13 @@ void check_vtu_round_trip() {
   EXPECT_EQ(v.arrays.at("position").components, 3);
   EXPECT_EQ(v.arrays.at("TimeValue").section, "FieldData");
   EXPECT_EQ(v.block<double>("TimeValue"), std::vector<double>{1.25});
+  // VTK reads FieldData arrays only as far as their NumberOfTuples says.
+  EXPECT_EQ(v.arrays.at("TimeValue").tuples, 1u);
+  for (const auto& [name, a] : v.arrays) {
+    if (name != "TimeValue") {
+      EXPECT_EQ(a.tuples, n) << name;
+    }
+  }
 
   // Blocks tile the appended section exactly, in offset order, each sized by its header.
   std::vector<std::pair<std::uint64_t, std::string>> order;
@@ -158,9 +168,15 @@ void check_vtu_round_trip() {
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"frame.vtu"});
 }
 
-TEST(VtuWriter, RoundTrip2DFloat) { check_vtu_round_trip<2, float>(); }
-TEST(VtuWriter, RoundTrip3DDouble) { check_vtu_round_trip<3, double>(); }
-TEST(VtuWriter, RoundTrip3DFloat) { check_vtu_round_trip<3, float>(); }
+TEST(VtuWriter, RoundTrip2DFloat) {
+  check_vtu_round_trip<2, float>();
+}
+TEST(VtuWriter, RoundTrip3DDouble) {
+  check_vtu_round_trip<3, double>();
+}
+TEST(VtuWriter, RoundTrip3DFloat) {
+  check_vtu_round_trip<3, float>();
+}
 
 TEST(VtuWriter, EmptyParticleSetIsValid) {
   test::TempDir dir("vtu_empty");
@@ -184,17 +200,77 @@ TEST(VtuWriter, UnwritableFolderIsAnInputError) {
   EXPECT_TRUE(dir.listing().empty());
 }
 
+TEST(VtuWriter, InconsistentFieldLengthsAreRefusedBeforeWriting) {
+  test::TempDir dir("vtu_sizes");
+  auto p = test::make_particles<3, double>(4);
+  p.level.pop_back();
+  EXPECT_THROW(write_vtu(p, 0.0, dir / "f.vtu"), std::logic_error);
+  EXPECT_TRUE(dir.listing().empty());
+}
+
+// The real consumer: VTK's own XML reader (ParaView's), through Debian's python3-vtk9 when installed.
+TEST(VtuWriter, ReadBackByVtkWhenInstalled) {
+  if (std::system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-vtk9 is not installed; the independent parser above still checks the format";
+  test::TempDir dir("vtu_vtk");
+  const auto p = test::make_particles<2, float>(6);
+  write_vtu(p, 0.75, dir / "f.vtu");
+  test::spit(dir / "read.py",
+             "import sys, vtk\n"
+             "r = vtk.vtkXMLUnstructuredGridReader()\n"
+             "r.SetFileName(sys.argv[1])\n"
+             "r.Update()\n"
+             "g = r.GetOutput()\n"
+             "pd = g.GetPointData()\n"
+             "print(g.GetNumberOfPoints(), g.GetNumberOfCells(), g.GetCellType(0))\n"
+             "print(g.GetFieldData().GetArray('TimeValue').GetValue(0))\n"
+             "print(repr(g.GetPoint(4)))\n"
+             "print(pd.GetArray('density').GetValue(4), pd.GetArray('phase').GetValue(4), "
+             "pd.GetArray('velocity').GetNumberOfComponents())\n");
+  const auto out = dir / "out.txt";
+  const std::string cmd = "/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "f.vtu").string() +
+                          " > " + out.string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::slurp(out);
+  std::istringstream lines(test::slurp(out));
+  std::string l1, l2, l3, l4;
+  std::getline(lines, l1);
+  std::getline(lines, l2);
+  std::getline(lines, l3);
+  std::getline(lines, l4);
+  EXPECT_EQ(l1, "6 6 1");  // points, cells, VTK_VERTEX
+  EXPECT_EQ(l2, "0.75");
+  // Python prints the float32 values widened to double, shortest repr.
+  auto widened = [](float v) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.17g", static_cast<double>(v));
+    return std::stod(buf);
+  };
+  double x, y, z;
+  ASSERT_EQ(std::sscanf(l3.c_str(), "(%lf, %lf, %lf)", &x, &y, &z), 3) << l3;
+  EXPECT_EQ(x, widened(p.x[4][0]));
+  EXPECT_EQ(y, widened(p.x[4][1]));
+  EXPECT_EQ(z, 0.0);
+  double rho;
+  int phase, comps;
+  ASSERT_EQ(std::sscanf(l4.c_str(), "%lf %d %d", &rho, &phase, &comps), 3) << l4;
+  EXPECT_EQ(rho, widened(p.rho[4]));
+  EXPECT_EQ(phase, p.phase[4]);
+  EXPECT_EQ(comps, 3);
+}
+
 TEST(PvdWriter, ListsEveryFrameWithItsTimeAfterEachAdd) {
   test::TempDir dir("pvd");
   PvdWriter pvd(dir / "run.pvd");
   pvd.add(0.0, "frame_00000.vtu");
   const std::string one = test::slurp(dir / "run.pvd");
-  EXPECT_NE(one.find("<DataSet timestep=\"0\" group=\"\" part=\"0\" file=\"frame_00000.vtu\"/>"), std::string::npos);
+  EXPECT_NE(one.find("<DataSet timestep=\"0\" group=\"\" part=\"0\" file=\"frame_00000.vtu\"/>"),
+            std::string::npos);
   EXPECT_EQ(one.find("frame_00001"), std::string::npos);
   pvd.add(0.1, "frame_00001.vtu");
   const std::string two = test::slurp(dir / "run.pvd");
   EXPECT_NE(two.find("type=\"Collection\""), std::string::npos);
-  EXPECT_NE(two.find("<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"frame_00001.vtu\"/>"), std::string::npos);
+  EXPECT_NE(two.find("<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"frame_00001.vtu\"/>"),
+            std::string::npos);
   EXPECT_NE(two.rfind("</VTKFile>\n"), std::string::npos);
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"run.pvd"});
 

@@ -96,8 +96,9 @@ void draw_text(Image& image, int x, int y, std::string_view text, Rgb8 colour, i
     const int gx = x + static_cast<int>(i) * kGlyphAdvance * scale;
     for (int row = 0; row < kGlyphHeight; ++row)
       for (int col = 0; col < kGlyphWidth; ++col)
-        if (g.rows[row][col] == '#') image.fill_rect(gx + col * scale, y + row * scale, gx + (col + 1) * scale,
-                                                      y + (row + 1) * scale, colour);
+        if (g.rows[row][col] == '#')
+          image.fill_rect(gx + col * scale, y + row * scale, gx + (col + 1) * scale, y + (row + 1) * scale,
+                          colour);
   }
 }
 

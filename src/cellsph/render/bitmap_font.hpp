@@ -17,7 +17,9 @@ bool glyph_pixel(char c, int col, int row);
 
 // Pixel width and height of `text` at integer `scale`.
 int text_width(std::string_view text, int scale);
-inline int text_height(int scale) { return kGlyphHeight * scale; }
+inline int text_height(int scale) {
+  return kGlyphHeight * scale;
+}
 
 // Draws `text` with its top-left corner at (x, y), each font pixel a scale x scale square.
 void draw_text(Image& image, int x, int y, std::string_view text, Rgb8 colour, int scale);

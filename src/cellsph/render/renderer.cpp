@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
 #include "cellsph/render/bitmap_font.hpp"
 
 namespace cellsph {
@@ -19,23 +20,35 @@ constexpr double kPi = 3.14159265358979323846;
 struct V3 {
   double x = 0, y = 0, z = 0;
 };
-V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+V3 operator+(V3 a, V3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+V3 operator-(V3 a, V3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V3 operator*(double s, V3 a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+double dot(V3 a, V3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 V3 normalized(V3 a) {
   const double n = std::sqrt(dot(a, a));
   return n > 0 ? (1 / n) * a : a;
 }
-V3 to_v3(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+V3 to_v3(const std::array<double, 3>& a) {
+  return {a[0], a[1], a[2]};
+}
 
 // Pinhole or parallel projection onto the (supersampled) frame buffer. View coordinates: right, up,
 // and depth along the viewing direction (positive in front of the camera).
 struct View {
   V3 eye, right, up, fwd;
   bool ortho = false;
-  double focal = 1;  // perspective: pixels per unit of (lateral / depth); ortho: pixels per world unit
+  double focal = 1;       // perspective: pixels per unit of (lateral / depth); ortho: pixels per world unit
   double cx = 0, cy = 0;  // screen position of the optical axis
   double near = 1e-9;
 
@@ -55,7 +68,9 @@ struct View {
     sy = cy - focal * v.y / v.z;
     return true;
   }
-  [[nodiscard]] double pixel_radius(double r, double depth) const { return ortho ? focal * r : focal * r / depth; }
+  [[nodiscard]] double pixel_radius(double r, double depth) const {
+    return ortho ? focal * r : focal * r / depth;
+  }
 };
 
 struct Sprite {
@@ -69,54 +84,85 @@ struct FrameBuffer {
   std::vector<float> rgb;
   std::vector<float> depth;
   FrameBuffer(int width, int height, Rgb8 bg)
-      : w(width), h(height), rgb(3 * static_cast<std::size_t>(width) * height),
+      : w(width),
+        h(height),
+        rgb(3 * static_cast<std::size_t>(width) * height),
         depth(static_cast<std::size_t>(width) * height, std::numeric_limits<float>::infinity()) {
     for (std::size_t i = 0; i < rgb.size(); i += 3)
       for (int k = 0; k < 3; ++k) rgb[i + k] = static_cast<float>(bg[k]);
   }
 };
 
+// A sprite placed on the screen.
+struct Placed {
+  double sx, sy, rp, depth, radius;
+  Rgb8 colour;
+  int y0, y1;  // rows covered
+};
+
 // One directional light fixed to the camera (upper left, in front), Lambert plus a Blinn highlight.
+// Sprites are drawn front to back (fewer shaded pixels that a nearer one would overwrite) and the frame
+// is cut into bands of rows shaded in parallel; every pixel sees the sprites in the same order whatever
+// the thread count, so the image is deterministic.
 void shade_sprites(FrameBuffer& fb, const View& view, const std::vector<Sprite>& sprites) {
-  const V3 light = normalized({-0.45, 0.65, -0.6});
-  const V3 half = normalized(light + V3{0, 0, -1});
+  std::vector<Placed> placed;
+  placed.reserve(sprites.size());
   for (const auto& s : sprites) {
     const V3 c = view.to_view(s.centre);
     double sx, sy;
     if (!view.project(c, sx, sy)) continue;
     const double rp = std::max(0.75, view.pixel_radius(s.radius, c.z));
-    const int x0 = std::max(0, static_cast<int>(std::floor(sx - rp)));
-    const int x1 = std::min(fb.w - 1, static_cast<int>(std::ceil(sx + rp)));
+    if (sx + rp < 0 || sx - rp > fb.w || sy + rp < 0 || sy - rp > fb.h) continue;
     const int y0 = std::max(0, static_cast<int>(std::floor(sy - rp)));
     const int y1 = std::min(fb.h - 1, static_cast<int>(std::ceil(sy + rp)));
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        const double dx = (x + 0.5 - sx) / rp;
-        const double dy = (sy - (y + 0.5)) / rp;
-        const double q = dx * dx + dy * dy;
-        if (q > 1) continue;
-        const double nz = std::sqrt(1 - q);
-        // Depth of the sphere's front surface at this pixel: the impostor behaves like a real sphere
-        // where particles overlap.
-        const auto d = static_cast<float>(c.z - s.radius * nz);
-        const std::size_t idx = static_cast<std::size_t>(y) * fb.w + x;
-        if (!(d < fb.depth[idx])) continue;
-        fb.depth[idx] = d;
-        const V3 n{dx, dy, -nz};
-        const double diffuse = std::max(0.0, dot(n, light));
-        const double spec = std::pow(std::max(0.0, dot(n, half)), 40.0);
-        for (int k = 0; k < 3; ++k) {
-          const double v = s.colour[k] * (0.3 + 0.7 * diffuse) + 90.0 * spec;
-          fb.rgb[3 * idx + k] = static_cast<float>(std::min(255.0, v));
+    placed.push_back({sx, sy, rp, c.z, s.radius, s.colour, y0, y1});
+  }
+  std::stable_sort(placed.begin(), placed.end(),
+                   [](const Placed& a, const Placed& b) { return a.depth < b.depth; });
+
+  const V3 light = normalized({-0.45, 0.65, -0.6});
+  const V3 half = normalized(light + V3{0, 0, -1});
+  constexpr int band = 32;
+  const auto bands = static_cast<std::size_t>((fb.h + band - 1) / band);
+  parallel_chunks(bands, 1, [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t bi = b0; bi < b1; ++bi) {
+      const int row0 = static_cast<int>(bi) * band, row1 = std::min(fb.h - 1, row0 + band - 1);
+      for (const auto& s : placed) {
+        if (s.y1 < row0 || s.y0 > row1) continue;
+        const int x0 = std::max(0, static_cast<int>(std::floor(s.sx - s.rp)));
+        const int x1 = std::min(fb.w - 1, static_cast<int>(std::ceil(s.sx + s.rp)));
+        const double inv = 1 / s.rp;
+        for (int y = std::max(row0, s.y0); y <= std::min(row1, s.y1); ++y) {
+          const double dy = (s.sy - (y + 0.5)) * inv;
+          for (int x = x0; x <= x1; ++x) {
+            const double dx = (x + 0.5 - s.sx) * inv;
+            const double q = dx * dx + dy * dy;
+            if (q > 1) continue;
+            const double nz = std::sqrt(1 - q);
+            // Depth of the sphere's front surface at this pixel: the impostor behaves like a real
+            // sphere where particles overlap.
+            const auto d = static_cast<float>(s.depth - s.radius * nz);
+            const std::size_t idx = static_cast<std::size_t>(y) * fb.w + x;
+            if (!(d < fb.depth[idx])) continue;
+            fb.depth[idx] = d;
+            const V3 n{dx, dy, -nz};
+            const double diffuse = std::max(0.0, dot(n, light));
+            const double h1 = std::max(0.0, dot(n, half)), h2 = h1 * h1, h4 = h2 * h2, h8 = h4 * h4;
+            const double spec = h8 * h8 * h8 * h8 * h8;  // exponent 40
+            for (int k = 0; k < 3; ++k) {
+              const double v = s.colour[k] * (0.3 + 0.7 * diffuse) + 90.0 * spec;
+              fb.rgb[3 * idx + k] = static_cast<float>(std::min(255.0, v));
+            }
+          }
         }
       }
     }
-  }
+  });
 }
 
 // A world-space segment, `thickness` pixels wide; depth-tested unless depth_test is false.
-void draw_segment(FrameBuffer& fb, const View& view, V3 a, V3 b, double thickness, Rgb8 colour, bool depth_test,
-                  double bias) {
+void draw_segment(FrameBuffer& fb, const View& view, V3 a, V3 b, double thickness, Rgb8 colour,
+                  bool depth_test, double bias) {
   V3 va = view.to_view(a), vb = view.to_view(b);
   if (!view.ortho) {  // clip against the near plane
     const double nearz = 1e-6;
@@ -151,7 +197,8 @@ void draw_segment(FrameBuffer& fb, const View& view, V3 a, V3 b, double thicknes
 Image downsample(const FrameBuffer& fb, int ss) {
   Image img(fb.w / ss, fb.h / ss);
   const double inv = 1.0 / (ss * ss);
-  for (int y = 0; y < img.height; ++y)
+  parallel_for(static_cast<std::size_t>(img.height), [&](std::size_t row) {
+    const int y = static_cast<int>(row);
     for (int x = 0; x < img.width; ++x) {
       double acc[3] = {0, 0, 0};
       for (int j = 0; j < ss; ++j)
@@ -164,6 +211,7 @@ Image downsample(const FrameBuffer& fb, int ss) {
                static_cast<std::uint8_t>(std::lround(std::clamp(acc[1] * inv, 0.0, 255.0))),
                static_cast<std::uint8_t>(std::lround(std::clamp(acc[2] * inv, 0.0, 255.0)))});
     }
+  });
   return img;
 }
 
@@ -277,9 +325,15 @@ ViewAndScale make_view(int dim, const RenderOptions& o, const RenderBox& box, co
   }
   v.eye = to_v3(cam.position);
   v.fwd = normalized(to_v3(cam.target) - v.eye);
-  CELLSPH_CHECK(dot(v.fwd, v.fwd) > 0, "camera position equals its target");
+  if (!(dot(v.fwd, v.fwd) > 0)) throw InputError("render camera: position equals target");
   v.right = normalized(cross(v.fwd, to_v3(cam.up)));
-  CELLSPH_CHECK(dot(v.right, v.right) > 0, "camera up vector is parallel to the viewing direction");
+  if (!(dot(v.right, v.right) > 0))
+    throw InputError("render camera: up vector is zero or parallel to the viewing direction");
+  if (!cam.orthographic && !(cam.fov_y_deg > 0 && cam.fov_y_deg < 180))
+    throw InputError("render camera: field of view " + format("%g", cam.fov_y_deg) +
+                     " degrees is outside (0, 180)");
+  if (cam.orthographic && cam.ortho_height < 0)
+    throw InputError("render camera: orthographic height " + format("%g", cam.ortho_height) + " is negative");
   v.up = cross(v.right, v.fwd);
   v.ortho = cam.orthographic;
   const double target_dist = std::sqrt(dot(to_v3(cam.target) - v.eye, to_v3(cam.target) - v.eye));
@@ -304,7 +358,9 @@ void box_edges(int dim, const RenderBox& box, std::vector<std::pair<V3, V3>>& ed
     edges = {{a, b}, {b, c}, {c, d}, {d, a}};
     return;
   }
-  auto corner = [&](int i) { return V3{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z}; };
+  auto corner = [&](int i) {
+    return V3{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z};
+  };
   for (int i = 0; i < 8; ++i)
     for (int bit = 1; bit < 8; bit <<= 1)
       if (!(i & bit)) edges.emplace_back(corner(i), corner(i | bit));
@@ -313,7 +369,8 @@ void box_edges(int dim, const RenderBox& box, std::vector<std::pair<V3, V3>>& ed
 const Rgb8 kInk{25, 25, 25};
 
 void draw_label(Image& img, int x, int y, const std::string& text, int font, Rgb8 bg) {
-  img.fill_rect(x - font, y - font, x + text_width(text, font) + font, y + text_height(font) + font, bg, 0.75);
+  img.fill_rect(x - font, y - font, x + text_width(text, font) + font, y + text_height(font) + font, bg,
+                0.75);
   draw_text(img, x, y, text, kInk, font);
 }
 
@@ -328,7 +385,7 @@ ColorBy parse_color_by(std::string_view name, std::string_view what) {
 }
 
 Rgb8 phase_colour(int phase) {
-  static constexpr Rgb8 palette[8] = {{40, 110, 220}, {240, 140, 30}, {50, 170, 80}, {210, 50, 50},
+  static constexpr Rgb8 palette[8] = {{40, 110, 220}, {240, 140, 30}, {50, 170, 80},   {210, 50, 50},
                                       {150, 90, 200}, {140, 90, 50},  {230, 110, 180}, {20, 170, 180}};
   if (phase < 0) return {150, 150, 150};
   return palette[phase % 8];
@@ -349,15 +406,22 @@ Rgb8 colormap(double t) {
 
 template <int Dim, class Real>
 Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const RenderBox& box, double time) {
-  CELLSPH_CHECK(o.width > 0 && o.height > 0 && o.width <= 16384 && o.height <= 16384,
-                "image size " << o.width << "x" << o.height);
-  CELLSPH_CHECK(o.supersample >= 1 && o.supersample <= 4, "supersample " << o.supersample);
+  if (!(o.width > 0 && o.height > 0 && o.width <= 16384 && o.height <= 16384))
+    throw InputError("render image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                     " is outside 1..16384");
+  if (!(o.supersample >= 1 && o.supersample <= 4))
+    throw InputError("render supersample " + std::to_string(o.supersample) + " is outside 1..4");
+  if (o.up_axis != 1 && o.up_axis != 2)
+    throw InputError("render up axis " + std::to_string(o.up_axis) + " must be 1 (y) or 2 (z)");
   const int ss = o.supersample;
   const Layout layout = make_layout(o);
   const ViewAndScale vs = make_view(Dim, o, box, layout);
 
   // The scalar to colour by, and its range.
   const auto n = p.size();
+  CELLSPH_CHECK(p.v.size() == n && p.p.size() == n && p.m.size() == n && p.rho.size() == n &&
+                    p.h.size() == n && p.phase.size() == n,
+                "particle fields of unequal length");
   auto value = [&](std::size_t i) -> double {
     if (o.color_by == ColorBy::Speed) return std::sqrt(static_cast<double>(norm2(p.v[i])));
     if (o.color_by == ColorBy::Pressure) return static_cast<double>(p.p[i]);
@@ -455,7 +519,7 @@ void render_png(const Particles<Dim, Real>& particles, const RenderOptions& opti
   write_png(render_image(particles, options, box, time), path);
 }
 
-#define CELLSPH_RENDER_INSTANTIATE(D, R)                                                                   \
+#define CELLSPH_RENDER_INSTANTIATE(D, R)                                                                     \
   template Image render_image<D, R>(const Particles<D, R>&, const RenderOptions&, const RenderBox&, double); \
   template void render_png<D, R>(const Particles<D, R>&, const RenderOptions&, const RenderBox&, double,     \
                                  const std::filesystem::path&);

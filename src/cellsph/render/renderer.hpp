@@ -31,9 +31,9 @@ struct Camera {
   std::array<double, 3> position{0, 0, 5};
   std::array<double, 3> target{0, 0, 0};
   std::array<double, 3> up{0, 1, 0};
-  double fov_y_deg = 35;       // perspective only
+  double fov_y_deg = 35;  // perspective only
   bool orthographic = false;
-  double ortho_height = 0;     // orthographic only: world units across the image height; 0 = frame the box
+  double ortho_height = 0;  // orthographic only: world units across the image height; 0 = frame the box
 };
 
 struct RenderOptions {
@@ -43,10 +43,10 @@ struct RenderOptions {
   // 3D camera; unset = look at the box centre from the front-right-above, framing the whole box.
   // 2D always uses a fitted orthographic top view.
   std::optional<Camera> camera;
-  int up_axis = 1;  // world axis that points up in the default 3D camera (1 = y, 2 = z)
+  int up_axis = 1;             // world axis that points up in the default 3D camera (1 = y, 2 = z)
   double particle_radius = 0;  // world units; 0 = half the spacing (m/rho)^(1/Dim) of each particle
   std::optional<double> range_min, range_max;  // colour-map range for speed/pressure; unset = data range
-  int supersample = 2;  // samples per pixel along each axis
+  int supersample = 2;                         // samples per pixel along each axis
   bool box_outline = true;
   bool scale_bar = true;
   bool time_label = true;

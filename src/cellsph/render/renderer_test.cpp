@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
 #include "cellsph/io/io_test_util.hpp"
 #include "cellsph/render/bitmap_font.hpp"
 #include "cellsph/render/video.hpp"
@@ -13,8 +14,12 @@ namespace cellsph {
 namespace {
 
 // Colour classes judged from the pixel alone, independent of the renderer's palette code.
-bool bluish(Rgb8 c) { return c[2] > c[0] + 40 && c[2] > c[1] + 20; }
-bool orangeish(Rgb8 c) { return c[0] > c[2] + 60 && c[0] > c[1]; }
+bool bluish(Rgb8 c) {
+  return c[2] > c[0] + 40 && c[2] > c[1] + 20;
+}
+bool orangeish(Rgb8 c) {
+  return c[0] > c[2] + 60 && c[0] > c[1];
+}
 bool dark_grey(Rgb8 c) {
   const int mx = std::max({c[0], c[1], c[2]}), mn = std::min({c[0], c[1], c[2]});
   return mx < 140 && mx - mn < 12;
@@ -73,10 +78,12 @@ TEST(Renderer, TwoDimensionalDiscsSitWhereTheParticlesAre) {
   EXPECT_TRUE(bluish(img.at(px(0.5), py(0.5))));
   EXPECT_TRUE(orangeish(img.at(px(1.5), py(0.5))));
   for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
-    const int ox = static_cast<int>(std::lround(0.6 * r * dx)), oy = static_cast<int>(std::lround(0.6 * r * dy));
+    const int ox = static_cast<int>(std::lround(0.6 * r * dx)),
+              oy = static_cast<int>(std::lround(0.6 * r * dy));
     EXPECT_TRUE(bluish(img.at(px(0.5) + ox, py(0.5) + oy))) << dx << "," << dy;
     EXPECT_TRUE(orangeish(img.at(px(1.5) + ox, py(0.5) + oy))) << dx << "," << dy;
-    const int fx = static_cast<int>(std::lround(1.4 * r * dx)), fy = static_cast<int>(std::lround(1.4 * r * dy));
+    const int fx = static_cast<int>(std::lround(1.4 * r * dx)),
+              fy = static_cast<int>(std::lround(1.4 * r * dy));
     EXPECT_EQ(img.at(px(0.5) + fx, py(0.5) + fy), kBackground) << dx << "," << dy;
     EXPECT_EQ(img.at(px(1.5) + fx, py(0.5) + fy), kBackground) << dx << "," << dy;
   }
@@ -174,7 +181,7 @@ TEST(Renderer, SpeedColourMapAndExplicitRange) {
   const double s = 0.96 * 300;
   auto px = [&](double w) { return static_cast<int>(std::lround(150 + (w - 0.5) * s)); };
   const Image img = render_image(p, o, box, 0.0);
-  EXPECT_TRUE(bluish(img.at(px(0.25), 150)));  // slowest end of the map
+  EXPECT_TRUE(bluish(img.at(px(0.25), 150)));                             // slowest end of the map
   EXPECT_TRUE(img.at(px(0.75), 150)[0] > img.at(px(0.75), 150)[2] + 60);  // fastest: red
   o.range_min = 0.0;
   o.range_max = 10.0;  // now 2 m/s is low in the range
@@ -203,9 +210,9 @@ TEST(Renderer, LabelsAppearOnlyWhenAsked) {
       for (int x = x0; x < x1; ++x) n += dark_grey(img.at(x, y));
     return n;
   };
-  EXPECT_GT(ink_in(with, 0, 0, 200, 40), 50);         // "t = 1.250 s"
-  EXPECT_GT(ink_in(with, 0, 660, 300, 720), 50);      // scale bar and its label
-  EXPECT_GT(ink_in(with, 1050, 0, 1280, 40), 20);     // legend
+  EXPECT_GT(ink_in(with, 0, 0, 200, 40), 50);      // "t = 1.250 s"
+  EXPECT_GT(ink_in(with, 0, 660, 300, 720), 50);   // scale bar and its label
+  EXPECT_GT(ink_in(with, 1050, 0, 1280, 40), 20);  // legend
   o.time_label = o.scale_bar = o.legend = false;
   const Image without = render_image(p, o, box, 1.25);
   EXPECT_EQ(ink_in(without, 0, 0, 200, 40), 0);
@@ -228,6 +235,57 @@ TEST(Renderer, PngIsDecodableDeterministicAndAtomic) {
   EXPECT_EQ(test::slurp(dir / "g.png"), bytes);
   EXPECT_EQ(dir.listing(), (std::vector<std::string>{"f.png", "g.png"}));
   EXPECT_THROW(read_png(dir / "missing.png"), InputError);
+}
+
+TEST(Renderer, BadOptionsAreInputErrors) {
+  const auto p = make_scene<3>({{Vec<3, double>{{0.5, 0.5, 0.5}}, 0}});
+  RenderOptions o = bare(64, 48);
+  o.camera = Camera{{1, 1, 1}, {1, 1, 1}, {0, 1, 0}, 35, false, 0};
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+  o.camera = Camera{{0, 0, 5}, {0, 0, 0}, {0, 0, 1}, 35, false, 0};  // up along the view
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+  o.camera = Camera{{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 180, false, 0};
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+  o.camera.reset();
+  o.width = 0;
+  EXPECT_THROW(render_image(p, o, RenderBox{}, 0.0), InputError);
+}
+
+TEST(Renderer, SameImageForAnyThreadCount) {
+  std::vector<std::pair<Vec<3, double>, int>> spec;
+  for (int i = 0; i < 400; ++i)
+    spec.push_back(
+        {Vec<3, double>{{0.05 + 0.002 * i, 0.5 + 0.3 * std::sin(i * 0.1), 0.3 + 0.001 * i}}, i % 3});
+  const auto p = make_scene<3>(spec);
+  RenderOptions o = bare(320, 240);
+  o.particle_radius = 0.04;
+  Image one, two;
+  {
+    ScopedThreads t(1);
+    one = render_image(p, o, RenderBox{}, 0.0);
+  }
+  {
+    ScopedThreads t(2);
+    two = render_image(p, o, RenderBox{}, 0.0);
+  }
+  EXPECT_EQ(one.rgb, two.rgb);
+}
+
+TEST(Image, IncompressibleImageRoundTripsThroughPng) {
+  // Noise compresses worse than the first buffer guess, so the encoder's second pass is exercised.
+  test::TempDir dir("png_noise");
+  Image img(64, 48);
+  std::uint32_t state = 12345;
+  for (auto& b : img.rgb) {
+    state = state * 1664525u + 1013904223u;
+    b = static_cast<std::uint8_t>(state >> 24);
+  }
+  write_png(img, dir / "n.png");
+  const Image back = read_png(dir / "n.png");
+  EXPECT_EQ(back.width, 64);
+  EXPECT_EQ(back.height, 48);
+  EXPECT_EQ(back.rgb, img.rgb);
+  EXPECT_GT(std::filesystem::file_size(dir / "n.png"), img.rgb.size() / 2 + 4096);
 }
 
 TEST(BitmapFont, GlyphsAndText) {
@@ -260,14 +318,19 @@ TEST(Video, MissingFfmpegIsReportedNotFatal) {
 }
 
 TEST(Video, EncodesFramesWhenFfmpegIsInstalled) {
-  if (!find_on_path("ffmpeg")) GTEST_SKIP() << "ffmpeg is not installed here; the missing case is tested above";
+  if (!find_on_path("ffmpeg"))
+    GTEST_SKIP() << "ffmpeg is not installed here; the missing case is tested above";
   test::TempDir dir("video_enc");
   const auto p = make_scene<2>({{Vec<2, double>{{0.5, 0.5}}, 0}});
   RenderOptions o = bare(161, 91);  // odd sizes must be padded for yuv420p
-  for (int f = 0; f < 3; ++f) render_png(p, o, RenderBox{}, f * 0.1, dir / ("frame_0000" + std::to_string(f) + ".png"));
+  for (int f = 0; f < 3; ++f)
+    render_png(p, o, RenderBox{}, f * 0.1, dir / ("frame_0000" + std::to_string(f) + ".png"));
   const auto r = make_mp4(dir.path(), "frame_%05d.png", 10, dir / "out.mp4");
   EXPECT_TRUE(r.ok) << r.message;
   EXPECT_GT(std::filesystem::file_size(dir / "out.mp4"), 100u);
+  EXPECT_EQ(test::slurp(dir / "out.mp4").substr(4, 4), "ftyp");  // an ISO media file
+  EXPECT_EQ(dir.listing(),
+            (std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png", "out.mp4"}));
 }
 
 }  // namespace
