@@ -4,6 +4,9 @@ set -euo pipefail
 PKGS=(g++ cmake ninja-build git pkg-config
       nlohmann-json3-dev libcli11-dev libnanoflann-dev libstb-dev libpng-dev
       libgtest-dev libgmock-dev libbenchmark-dev)
+# With --test: what the tests use to check outputs with other people's tools (ffmpeg for the MP4,
+# VTK's own .vtu reader through Debian's python3-vtk9).
+if [ "${1:-}" = "--test" ]; then PKGS+=(ffmpeg python3-vtk9); fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

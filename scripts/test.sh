@@ -2,7 +2,7 @@
 # Installs what is needed, builds cellsph twice (release, and ASan+UBSan) and runs every test in both.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+scripts/setup.sh --test
 JOBS=${JOBS:-$(nproc)}
 
 echo "== release build =="

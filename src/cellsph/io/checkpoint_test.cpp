@@ -135,7 +135,9 @@ TEST_F(CheckpointErrors, TruncatedAnywhere) {
 }
 
 TEST_F(CheckpointErrors, CorruptedDataFailsTheChecksum) {
-  const auto m = with([](std::string& b) { b[b.size() - 20] ^= 0x10; });
+  // Flip one bit inside the position data (after its name, element size and count).
+  const auto at = good_.find("position") + 8 + 4 + 8 + 3;
+  const auto m = with([at](std::string& b) { b[at] ^= 0x10; });
   EXPECT_NE(m.find("checksum mismatch"), std::string::npos) << m;
 }
 
@@ -145,14 +147,14 @@ TEST_F(CheckpointErrors, UnknownAndMissingFields) {
   const auto unknown = with([&](std::string& b) { b.replace(pos, 9, "viscosit2"); });
   EXPECT_NE(unknown.find("unknown field 'viscosit2'"), std::string::npos) << unknown;
 
-  // Drop the last field ("level": 4-byte name length, name, size, count, 10 int32) and lower the count.
-  const auto lvl = good_.rfind("level") - 4;
+  // Drop the last field ("kind": 4-byte name length, name, size, count, data) and lower the count.
+  const auto lvl = good_.rfind("kind") - 4;
   const auto missing = with([&](std::string& b) {
     const std::size_t nfields_at = 8 + 4 * 4 + 8 * 3 + 8 + 5;  // header, user blob "state"
     b[nfields_at] = static_cast<char>(b[nfields_at] - 1);
     b.erase(lvl, b.size() - 8 - lvl);
   });
-  EXPECT_NE(missing.find("missing field 'level'"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("missing field 'kind'"), std::string::npos) << missing;
 
   const auto dup = with([&](std::string& b) { b.replace(b.rfind("level"), 5, "phase"); });
   EXPECT_NE(dup.find("field 'phase' appears twice"), std::string::npos) << dup;
