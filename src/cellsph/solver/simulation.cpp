@@ -101,6 +101,11 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
       }
     } else {
       p_.v[i] = V{};
+      if (!(p_.m[i] >= 0 && std::isfinite(p_.m[i]))) {
+        std::ostringstream os;
+        os << "particles: boundary particle " << i << " has weight (mass) " << p_.m[i];
+        throw InputError(os.str());
+      }
     }
   }
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
@@ -116,7 +121,7 @@ void Simulation<Dim, Real>::init_boundary_weights() {
   compute_neighbors();
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
     parallel_for(p_.size(), [&](std::size_t b) {
-      if (p_.kind[b] != kBoundary) return;
+      if (p_.kind[b] != kBoundary || p_.m[b] > 0) return;  // a weight given by the scene is kept
       Real s = w.W2(0);
       for (const auto* it = nl_.begin(b); it != nl_.end(b); ++it)
         if (p_.kind[*it] == kBoundary) s += w.W2(distance2(p_.x[b], p_.x[*it]));
@@ -198,11 +203,13 @@ void Simulation<Dim, Real>::compute_forces_paper() {
           f += averaged_viscosity_force(in, wv);
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], p_.color[j], wc);
         } else {
-          // A boundary particle acts as fluid at rest density with i's own pressure (mirrored) and i's
-          // colour (walls are neutral to interface tension). Walls are free-slip: no viscosity.
+          // A boundary particle acts as fluid at rest density with i's pressure extrapolated to it (see
+          // mirrored_boundary_pressure) and i's colour (walls are neutral to interface tension). Walls are
+          // free-slip: no viscosity.
           in.mj = p_.m[j];
           in.rhoj = rho0_[i];
-          in.pj = p_.p[i];
+          in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
+          if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
           f += averaged_pressure_force(in, wp);
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / rho0_[i], p_.color[i], wc);
         }
@@ -254,7 +261,9 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
           fp += symmetric_pressure_force(in, wg);
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], Real(1), wc);
         } else {
-          fp += boundary_pressure_force(in.xij, in.mi, in.rhoi, in.pi, p_.m[j], wg);
+          Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
+          if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
+          fp += boundary_pressure_force(in.xij, in.mi, in.rhoi, in.pi, pb, p_.m[j], wg);
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / rho0_[i], Real(1), wc);
         }
       }

@@ -37,7 +37,9 @@ class Simulation {
   // Validates the config (InputError) and completes the particles: x, v, m, phase and kind are the inputs
   // (v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid particle:
   // the phase's mass). support, colour and viscosity are set from the config and the phase table,
-  // density to the rest density; boundary particles get their Akinci weight psi_b in m.
+  // density to the rest density; boundary particles with m == 0 get their Akinci weight psi_b in m (a
+  // positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick,
+  // m = rho0 spacing^Dim makes the wall look exactly like fluid).
   Simulation(Config config, Particles<Dim, Real> particles);
 
   // One time step of the configured model. Throws SimulationError (step, particle, quantity, value) when
