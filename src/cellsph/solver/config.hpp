@@ -29,6 +29,18 @@ enum class DensityFormulation {
 enum class TimeStepping {
   Fixed,    // dt = time.dt every step (the paper's test)
   Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
+  // Per-particle power-of-two steps (Desbrun 1996; eq. 12-13): particle i advances with dt_max / 2^n_i
+  // and is integrated only when the global clock reaches its own time. Paper model only.
+  PerParticle,
+};
+
+// What happens when a particle's step changes from dt_old to dt_new.
+enum class StepChangeCorrection {
+  // Variable-step leap-frog: the kick uses (dt_old + dt_new)/2, which lands the stored velocity on the
+  // new half step; exact under a constant force, no position correction needed.
+  Exact,
+  // Algorithm 1's kick v += dt_new f/m with eq. 13 as printed: r += (dt_new^2 - dt_old^2) / (8 m) f.
+  Printed,
 };
 
 // One fluid (or boundary material): the phases table of a scene.
@@ -78,6 +90,8 @@ struct SolverConfig {
     Real courant = Real(0.3); // alpha of eq. 12
     Real viscous = Real(0.125);  // dt <= viscous * h^2 rho0 / mu
     Real force = Real(0.25);     // dt <= force * sqrt(h / |a|max)
+    int max_level = 12;          // PerParticle: finest step dt_max / 2^max_level
+    StepChangeCorrection correction = StepChangeCorrection::Exact;
   } time{};
 
   // The write-up's box: a particle that leaves [lo + r, hi - r] is put back on the wall and its normal
@@ -118,6 +132,8 @@ std::string_view model_name(Model m);
 std::optional<Model> parse_model(std::string_view name);
 std::string_view time_stepping_name(TimeStepping t);
 std::optional<TimeStepping> parse_time_stepping(std::string_view name);
+std::string_view correction_name(StepChangeCorrection c);
+std::optional<StepChangeCorrection> parse_correction(std::string_view name);
 std::string_view density_formulation_name(DensityFormulation d);
 std::optional<DensityFormulation> parse_density_formulation(std::string_view name);
 
