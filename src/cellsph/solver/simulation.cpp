@@ -217,8 +217,11 @@ void Simulation<Dim, Real>::compute_forces_paper() {
         }
       }
       if (any_tension_) {
+        // Eq. 9 has the units of a force density (sigma [N/m] times a curvature of C [1/m^2]); by the
+        // paper's own eq. 6 the particle's force is V_i times it. Taken literally as a force it gives
+        // accelerations ~1e5 m/s^2 for the paper's sigma, m and h.
         const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-        f += interface_tension_force(cf, ph.sigma, cfg_.tension_threshold);
+        f += interface_tension_force(cf, ph.sigma, cfg_.tension_threshold) * vol_i;
       }
       p_.f[i] = f;
     });
