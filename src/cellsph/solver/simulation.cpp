@@ -634,11 +634,17 @@ void Simulation<Dim, Real>::load_state(std::istream& in) {
     in.read(reinterpret_cast<char*>(field.data()), static_cast<std::streamsize>(count * sizeof(T)));
     if (!in) throw InputError("checkpoint: truncated in field '" + std::string(name) + "'");
   });
+  for (std::size_t i = 0; i < n; ++i) {
+    if (loaded.phase[i] < 0 || static_cast<std::size_t>(loaded.phase[i]) >= cfg_.phases.size() ||
+        loaded.kind[i] > kBoundary) {
+      throw InputError("checkpoint: particle " + std::to_string(i) + " has phase " +
+                       std::to_string(loaded.phase[i]) + " / kind " + std::to_string(int(loaded.kind[i])) +
+                       ", not in this scene's tables");
+    }
+  }
   p_ = std::move(loaded);
   for (std::size_t i = 0; i < p_.size(); ++i)
-    rho0_[i] = cfg_.phases[static_cast<std::size_t>(std::clamp<std::int32_t>(p_.phase[i], 0,
-                                                       static_cast<std::int32_t>(cfg_.phases.size()) - 1))]
-                   .rest_density;
+    rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
   time_ = t;
   last_dt_ = ldt;
   steps_ = st;

@@ -120,7 +120,7 @@ TEST_P(BothModels, BitIdenticalAcrossRunsAndThreadCounts) {
   auto run = [&](int threads) {
     ScopedThreads t(threads);
     Simulation<2, double> sim(cfg, blob(8, 0.02, 3));
-    for (int s = 0; s < 40; ++s) sim.step();
+    for (int s = 0; s < 20; ++s) sim.step();
     return sim.particles();
   };
   const auto a = run(1), b = run(1), c = run(2);
