@@ -205,15 +205,16 @@ void Simulation<Dim, Real>::compute_forces_paper() {
           f += averaged_viscosity_force(in, wv);
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], p_.color[j], wc);
         } else {
-          // A boundary particle acts as fluid at rest density with i's pressure extrapolated to it (see
-          // mirrored_boundary_pressure) and i's colour (walls are neutral to interface tension). Walls are
-          // free-slip: no viscosity.
+          // A boundary particle acts as fluid with i's density (mirrored, so that its volume psi_b / rho_i
+          // matches how i sees fluid neighbours; with rho0 instead a resting fluid is pushed off the
+          // walls), i's pressure extrapolated to it (see mirrored_boundary_pressure) and i's colour (walls
+          // are neutral to interface tension). Walls are free-slip: no viscosity.
           in.mj = p_.m[j];
-          in.rhoj = rho0_[i];
+          in.rhoj = in.rhoi;
           in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
           f += averaged_pressure_force(in, wp);
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / rho0_[i], p_.color[i], wc);
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
         }
       }
       if (any_tension_) {
@@ -269,7 +270,7 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
           Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
           fp += boundary_pressure_force(in.xij, in.mi, in.rhoi, in.pi, pb, p_.m[j], wg);
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / rho0_[i], Real(1), wc);
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, Real(1), wc);
         }
       }
       if (any_tension_) {
