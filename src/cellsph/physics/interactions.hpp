@@ -23,7 +23,8 @@ struct PairInput {
 
 // ---- Density -----------------------------------------------------------------------------------
 
-// Paper eq. 7 / write-up mass density: rho_i = sum_j m_j W(r_ij) (the self term j = i included by the caller).
+// Paper eq. 7 / write-up mass density: rho_i = sum_j m_j W(r_ij) (the self term j = i included by the
+// caller).
 template <class Real, class Kernel>
 CELLSPH_HD inline Real density_term(const Kernel& w, Real mj, Real r2) {
   return mj * w.W2(r2);
@@ -108,8 +109,8 @@ CELLSPH_HD inline Real mirrored_boundary_pressure(Real pi, Real rhoi, const Vec<
 }
 
 template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Vec<Dim, Real> boundary_pressure_force(const Vec<Dim, Real>& xib, Real mi, Real rhoi, Real pi,
-                                                         Real pb, Real psib, const Kernel& w) {
+CELLSPH_HD inline Vec<Dim, Real> boundary_pressure_force(const Vec<Dim, Real>& xib, Real mi, Real rhoi,
+                                                         Real pi, Real pb, Real psib, const Kernel& w) {
   return w.gradW(xib) * (-mi * psib * (pi + pb) / (rhoi * rhoi));
 }
 

@@ -66,7 +66,9 @@ void SolverConfig<Dim, Real>::validate() const {
   if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
 }
 
-std::string_view model_name(Model m) { return m == Model::PaperMultiphase ? "paper" : "wcsph"; }
+std::string_view model_name(Model m) {
+  return m == Model::PaperMultiphase ? "paper" : "wcsph";
+}
 std::optional<Model> parse_model(std::string_view n) {
   if (n == "paper") return Model::PaperMultiphase;
   if (n == "wcsph") return Model::Wcsph;
@@ -74,9 +76,12 @@ std::optional<Model> parse_model(std::string_view n) {
 }
 std::string_view time_stepping_name(TimeStepping t) {
   switch (t) {
-    case TimeStepping::Fixed: return "fixed";
-    case TimeStepping::Courant: return "courant";
-    case TimeStepping::PerParticle: return "per-particle";
+    case TimeStepping::Fixed:
+      return "fixed";
+    case TimeStepping::Courant:
+      return "courant";
+    case TimeStepping::PerParticle:
+      return "per-particle";
   }
   return "?";
 }

@@ -85,9 +85,9 @@ struct SolverConfig {
 
   struct Time {
     TimeStepping mode = TimeStepping::Fixed;
-    Real dt = Real(0.002);    // Fixed: the step [s]
-    Real dt_max = Real(0.01); // Courant: upper bound of the step [s]
-    Real courant = Real(0.3); // alpha of eq. 12
+    Real dt = Real(0.002);       // Fixed: the step [s]
+    Real dt_max = Real(0.01);    // Courant: upper bound of the step [s]
+    Real courant = Real(0.3);    // alpha of eq. 12
     Real viscous = Real(0.125);  // dt <= viscous * h^2 rho0 / mu
     Real force = Real(0.25);     // dt <= force * sqrt(h / |a|max)
     int max_level = 12;          // PerParticle: finest step dt_max / 2^max_level

@@ -24,8 +24,8 @@ void add_particle(Particles<Dim, Real>& p, const Vec<Dim, Real>& x, std::int32_t
 // Fills [lo, hi] with fluid particles at the centres of a lattice of cells of size `spacing`, each of
 // mass `mass` (0: the phase's mass). Returns the number of particles added.
 template <int Dim, class Real>
-std::size_t add_block(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi, Real spacing,
-                      std::int32_t phase, Real mass = 0) {
+std::size_t add_block(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi,
+                      Real spacing, std::int32_t phase, Real mass = 0) {
   int n[3] = {1, 1, 1};
   for (int a = 0; a < Dim; ++a) n[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / spacing));
   std::size_t added = 0;

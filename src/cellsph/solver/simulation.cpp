@@ -393,11 +393,16 @@ void Simulation<Dim, Real>::check_state() const {
     for (int a = 0; a < Dim; ++a) os << (a ? ", " : "") << v[a];
     os << ")";
   };
-  if (!all_finite(p_.x[i])) vec("position", p_.x[i]);
-  else if (!all_finite(p_.v[i])) vec("velocity", p_.v[i]);
-  else if (!all_finite(p_.f[i])) vec("force", p_.f[i]);
-  else if (!std::isfinite(p_.rho[i])) os << "density = " << p_.rho[i];
-  else if (!std::isfinite(p_.p[i])) os << "pressure = " << p_.p[i];
+  if (!all_finite(p_.x[i]))
+    vec("position", p_.x[i]);
+  else if (!all_finite(p_.v[i]))
+    vec("velocity", p_.v[i]);
+  else if (!all_finite(p_.f[i]))
+    vec("force", p_.f[i]);
+  else if (!std::isfinite(p_.rho[i]))
+    os << "density = " << p_.rho[i];
+  else if (!std::isfinite(p_.p[i]))
+    os << "pressure = " << p_.p[i];
   else {
     vec("position", p_.x[i]);
     os << " left the domain";
@@ -449,8 +454,10 @@ void Simulation<Dim, Real>::step_per_particle() {
   for (std::size_t i = 0; i < n; ++i) {
     xs_[i] = p_.x[i];
     if (p_.kind[i] != kFluid) continue;
-    if (p_.tick[i] == T) due_[i] = 1;
-    else xs_[i] += p_.v[i] * (static_cast<Real>(T - p_.tick[i]) * unit);
+    if (p_.tick[i] == T)
+      due_[i] = 1;
+    else
+      xs_[i] += p_.v[i] * (static_cast<Real>(T - p_.tick[i]) * unit);
   }
   std::swap(p_.x, xs_);  // the force passes see positions at time T
   compute_neighbors();
@@ -513,14 +520,18 @@ void Simulation<Dim, Real>::step() {
 
   sw.reset();
   compute_density_pressure();
-  if (cfg_.model == Model::PaperMultiphase) compute_forces_paper();
-  else compute_forces_wcsph();
+  if (cfg_.model == Model::PaperMultiphase)
+    compute_forces_paper();
+  else
+    compute_forces_wcsph();
   timings_.forces += sw.ms();
 
   sw.reset();
   const Real dt = choose_dt();
-  if (cfg_.model == Model::PaperMultiphase) integrate_paper(dt);
-  else integrate_wcsph(dt);
+  if (cfg_.model == Model::PaperMultiphase)
+    integrate_paper(dt);
+  else
+    integrate_wcsph(dt);
   apply_walls();
   check_state();
   time_ += dt;
@@ -580,7 +591,8 @@ void Simulation<Dim, Real>::save_state(std::ostream& out) const {
     out.write(name.data(), static_cast<std::streamsize>(name.size()));
     put(out, static_cast<std::uint32_t>(sizeof(T)));
     put(out, static_cast<std::uint64_t>(field.size()));
-    out.write(reinterpret_cast<const char*>(field.data()), static_cast<std::streamsize>(field.size() * sizeof(T)));
+    out.write(reinterpret_cast<const char*>(field.data()),
+              static_cast<std::streamsize>(field.size() * sizeof(T)));
   });
   if (!out) throw InputError("checkpoint: write failed");
 }

@@ -43,8 +43,8 @@ class Simulation {
   Simulation(Config config, Particles<Dim, Real> particles);
 
   // One time step of the configured model (with per-particle steps: advances the particles whose own
-  // time is the global clock, then the clock to the next such time). Throws SimulationError (step, particle, quantity, value) when
-  // a particle's state is not finite or leaves the domain.
+  // time is the global clock, then the clock to the next such time). Throws SimulationError (step, particle,
+  // quantity, value) when a particle's state is not finite or leaves the domain.
   void step();
   // Steps until time() >= t_end (the last step is not shortened).
   void run_until(Real t_end);
@@ -89,10 +89,10 @@ class Simulation {
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
-  std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
-  std::vector<Real> rho0_;     // rest density per particle (from its phase)
-  std::vector<V> xs_;                // per-particle steps: every position extrapolated to the global clock
-  std::vector<std::uint8_t> due_;    // per-particle steps: 1 for the particles integrated this step
+  std::vector<V> f_pressure_;      // WCSPH: pressure force, applied after the predicted velocity
+  std::vector<Real> rho0_;         // rest density per particle (from its phase)
+  std::vector<V> xs_;              // per-particle steps: every position extrapolated to the global clock
+  std::vector<std::uint8_t> due_;  // per-particle steps: 1 for the particles integrated this step
   bool any_tension_ = false;
   std::size_t fluid_count_ = 0;
 

@@ -106,8 +106,8 @@ TEST_P(BothModels, LinearMomentumConservedToRoundOff) {
   const V2 p1 = sim.momentum();
   // Forces must not be trivially zero for this to mean anything.
   EXPECT_GT(max_f * sim.last_dt() * 60, 1e-3 * scale);
-  EXPECT_LT(norm(p1 - p0), 1e-12 * scale) << "p0 = " << p0[0] << "," << p0[1] << " p1 = " << p1[0] << ","
-                                          << p1[1];
+  EXPECT_LT(norm(p1 - p0), 1e-12 * scale)
+      << "p0 = " << p0[0] << "," << p0[1] << " p1 = " << p1[0] << "," << p1[1];
 }
 
 TEST_P(BothModels, BitIdenticalAcrossRunsAndThreadCounts) {
@@ -151,7 +151,9 @@ TEST_P(BothModels, CheckpointResumeIsBitIdentical) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Solver, BothModels, ::testing::Values(Model::PaperMultiphase, Model::Wcsph),
-                         [](const ::testing::TestParamInfo<Model>& pi) { return std::string(model_name(pi.param)); });
+                         [](const ::testing::TestParamInfo<Model>& pi) {
+                           return std::string(model_name(pi.param));
+                         });
 
 TEST(Checkpoint, RejectsMismatchedState) {
   auto cfg = base_config(Model::Wcsph);
