@@ -90,6 +90,14 @@ std::optional<TimeStepping> parse_time_stepping(std::string_view n) {
     if (time_stepping_name(t) == n) return t;
   return std::nullopt;
 }
+std::string_view tension_model_name(TensionModel t) {
+  return t == TensionModel::Paper ? "paper" : "csf";
+}
+std::optional<TensionModel> parse_tension_model(std::string_view n) {
+  if (n == "paper") return TensionModel::Paper;
+  if (n == "csf") return TensionModel::Csf;
+  return std::nullopt;
+}
 std::string_view correction_name(StepChangeCorrection c) {
   return c == StepChangeCorrection::Exact ? "exact" : "printed";
 }

@@ -26,6 +26,14 @@ enum class DensityFormulation {
   Number,  // Solenthaler & Pajarola 2008: delta_i = sum_j W_ij, rho_i = m_i delta_i, V_i = 1 / delta_i
 };
 
+// How the paper's model turns the colour field into interface tension.
+enum class TensionModel {
+  Paper,  // eq. 9: f = -sigma lap C grad C / |grad C| (Algorithm 1, lines 11-14)
+  // Continuum surface force with the curvature from the divergence of the unit normal (Brackbill 1992,
+  // in SPH as Morris 2000): n = sum_j V_j (c_j - c_i) grad W, kappa = -div(n / |n|), f = sigma kappa n.
+  Csf,
+};
+
 enum class TimeStepping {
   Fixed,    // dt = time.dt every step (the paper's test)
   Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
@@ -81,6 +89,7 @@ struct SolverConfig {
 
   // |grad C| below which no interface tension acts (Mueller 2003's threshold l; the write-up's 7.065).
   Real tension_threshold = 0;
+  TensionModel tension = TensionModel::Paper;
   V gravity = gravity_default();
 
   struct Time {
@@ -132,6 +141,8 @@ std::string_view model_name(Model m);
 std::optional<Model> parse_model(std::string_view name);
 std::string_view time_stepping_name(TimeStepping t);
 std::optional<TimeStepping> parse_time_stepping(std::string_view name);
+std::string_view tension_model_name(TensionModel t);
+std::optional<TensionModel> parse_tension_model(std::string_view name);
 std::string_view correction_name(StepChangeCorrection c);
 std::optional<StepChangeCorrection> parse_correction(std::string_view name);
 std::string_view density_formulation_name(DensityFormulation d);

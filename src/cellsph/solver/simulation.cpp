@@ -167,12 +167,33 @@ void Simulation<Dim, Real>::compute_density_pressure() {
   });
 }
 
-// Algorithm 1, lines 2-15: f_i = m_i g + eq. 8a + eq. 8b + eq. 9.
+// CSF normals n_i = sum_j V_j (c_j - c_i) grad W_ij: the difference form vanishes exactly inside a phase.
+// Walls take the colour of the fluid particle, so they contribute nothing.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_normals() {
+  const Poly6Kernel<Dim, Real> wc(cfg_.support);
+  normal_.assign(p_.size(), V{});
+  parallel_for(p_.size(), [&](std::size_t i) {
+    if (p_.kind[i] != kFluid) return;
+    V n{};
+    for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      const std::uint32_t j = *it;
+      if (p_.kind[j] != kFluid) continue;
+      n += wc.gradW(p_.x[i] - p_.x[j]) * (p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
+    }
+    normal_[i] = n;
+  });
+}
+
+// Algorithm 1, lines 2-15: f_i = m_i g + eq. 8a + eq. 8b + eq. 9 (or CSF).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_forces_paper() {
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
   const ViscosityKernel<Dim, Real> wv(cfg_.support);
   const Real lap_self = wc.laplacian(0);
+  const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
+  const Real thr2 = cfg_.tension_threshold * cfg_.tension_threshold;
+  if (csf) compute_normals();
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wp) {
     parallel_for(p_.size(), [&](std::size_t i) {
       if (p_.kind[i] != kFluid) {
@@ -191,6 +212,9 @@ void Simulation<Dim, Real>::compute_forces_paper() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
+      const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
+      const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
+      Real kappa = 0;  // CSF: -div(n / |n|) over neighbours with a defined normal
       for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
@@ -203,7 +227,12 @@ void Simulation<Dim, Real>::compute_forces_paper() {
           in.muj = p_.mu[j];
           f += averaged_pressure_force(in, wp);
           f += averaged_viscosity_force(in, wv);
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], p_.color[j], wc);
+          if (csf_i && norm2(normal_[j]) > thr2 && norm2(normal_[j]) > 0) {
+            const V nhat_j = normal_[j] / norm(normal_[j]);
+            kappa -= p_.m[j] / p_.rho[j] * dot(nhat_j - nhat_i, wc.gradW(in.xij));
+          } else if (any_tension_ && !csf) {
+            accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], p_.color[j], wc);
+          }
         } else {
           // A boundary particle acts as fluid with i's density (mirrored, so that its volume psi_b / rho_i
           // matches how i sees fluid neighbours; with rho0 instead a resting fluid is pushed off the
@@ -214,10 +243,13 @@ void Simulation<Dim, Real>::compute_forces_paper() {
           in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
           f += averaged_pressure_force(in, wp);
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
+          if (any_tension_ && !csf) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
         }
       }
-      if (any_tension_) {
+      if (csf_i) {
+        const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
+        f += normal_[i] * (ph.sigma * kappa * vol_i);
+      } else if (any_tension_ && !csf) {
         // Eq. 9 has the units of a force density (sigma [N/m] times a curvature of C [1/m^2]); by the
         // paper's own eq. 6 the particle's force is V_i times it. Taken literally as a force it gives
         // accelerations ~1e5 m/s^2 for the paper's sigma, m and h.

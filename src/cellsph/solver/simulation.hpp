@@ -75,6 +75,7 @@ class Simulation {
   void compute_neighbors();
   void compute_density_pressure();
   void compute_forces_paper();
+  void compute_normals();
   void compute_forces_wcsph();
   Real choose_dt() const;
   void integrate_paper(Real dt);
@@ -89,6 +90,7 @@ class Simulation {
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
+  std::vector<V> normal_;          // CSF: colour gradient n_i of the current step
   std::vector<V> f_pressure_;      // WCSPH: pressure force, applied after the predicted velocity
   std::vector<Real> rho0_;         // rest density per particle (from its phase)
   std::vector<V> xs_;              // per-particle steps: every position extrapolated to the global clock

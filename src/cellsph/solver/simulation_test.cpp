@@ -563,5 +563,52 @@ TEST(Solver, FloatTracksDouble) {
   EXPECT_LT(worst, 1e-5);  // metres, after particles moved ~5 mm
 }
 
+// Interface tension on a disc of fluid 1 (colour 1) in fluid 0 (colour 0), both at rest on a lattice with
+// no pressure: integrating a continuum surface force sigma kappa n delta over the upper half of a circle
+// of radius R gives sigma (1/R) (2R) = 2 sigma, pointing down (in 2D, independent of R). Sum of the
+// particle forces over y > centre, against that reference. Eq. 9 as printed is reported, not asserted:
+// its lap C carries the normal derivative of |grad C|, which does not integrate to the curvature term
+// (measured about twice the reference).
+double half_disc_tension(TensionModel model) {
+  const double s = 0.01, L = 0.3, R = 0.08, sigma = 1;
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.support = 3 * s;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.pressure_kernel = KernelKind::CubicSpline;
+  cfg.eos.kind = EosKind::Ratio;
+  cfg.eos.stiffness = 1e-9;  // no pressure: the force is the tension alone
+  cfg.phases[0].mass = 1000 * s * s;
+  cfg.phases[0].viscosity = 0;
+  cfg.phases[0].color = 0;
+  cfg.phases[0].sigma = sigma;
+  cfg.phases.push_back(cfg.phases[0]);
+  cfg.phases[1].color = 1;
+  cfg.tension = model;
+  cfg.tension_threshold = 0;
+  cfg.time.dt = 1e-9;
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 0);
+  const V2 c{{L / 2, L / 2}};
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (norm(p.x[i] - c) < R) p.phase[i] = 1;
+  ScopedThreads one(1);
+  Simulation<2, double> sim(cfg, p);
+  sim.step();
+  V2 f{};
+  for (std::size_t i = 0; i < sim.particles().size(); ++i)
+    if (sim.particles().x[i][1] > c[1]) f += sim.particles().f[i];
+  // Symmetric about the vertical axis (eq. 9 normalises the noise of grad C deep inside a phase, so only
+  // the CSF force, exactly zero there, is symmetric to round-off).
+  if (model == TensionModel::Csf) EXPECT_NEAR(f[0], 0, 1e-9);
+  return f[1];
+}
+
+TEST(InterfaceTension, HalfDiscForceMatchesTwoSigma) {
+  const double csf = half_disc_tension(TensionModel::Csf);
+  const double paper = half_disc_tension(TensionModel::Paper);
+  std::cout << "[tension] half-disc force (reference -2 N/m): CSF " << csf << ", eq. 9 " << paper << "\n";
+  EXPECT_NEAR(csf, -2.0, 0.2);  // within 10%: measured -1.89 (h = 3 spacings, R = 8 spacings)
+}
+
 }  // namespace
 }  // namespace cellsph
