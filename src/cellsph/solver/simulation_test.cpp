@@ -599,7 +599,9 @@ double half_disc_tension(TensionModel model) {
     if (sim.particles().x[i][1] > c[1]) f += sim.particles().f[i];
   // Symmetric about the vertical axis (eq. 9 normalises the noise of grad C deep inside a phase, so only
   // the CSF force, exactly zero there, is symmetric to round-off).
-  if (model == TensionModel::Csf) EXPECT_NEAR(f[0], 0, 1e-9);
+  if (model == TensionModel::Csf) {
+    EXPECT_NEAR(f[0], 0, 1e-9);
+  }
   return f[1];
 }
 
