@@ -69,7 +69,7 @@ class Simulation {
   void save_state(std::ostream& out) const;
   void load_state(std::istream& in);
 
-  static constexpr std::uint32_t kStateVersion = 1;
+  static constexpr std::uint32_t kStateVersion = 2;  // 2: the per-particle "tick" field
 
  private:
   void compute_neighbors();
