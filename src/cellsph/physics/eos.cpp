@@ -4,10 +4,14 @@ namespace cellsph {
 
 std::string_view eos_name(EosKind k) {
   switch (k) {
-    case EosKind::Tait: return "tait";
-    case EosKind::Linear: return "linear";
-    case EosKind::Ratio: return "ratio";
-    case EosKind::Seventh: return "seventh";
+    case EosKind::Tait:
+      return "tait";
+    case EosKind::Linear:
+      return "linear";
+    case EosKind::Ratio:
+      return "ratio";
+    case EosKind::Seventh:
+      return "seventh";
   }
   return "?";
 }

@@ -9,10 +9,10 @@
 namespace cellsph {
 
 enum class EosKind {
-  Tait,       // paper eq. 7: k ((rho/rho0)^gamma - 1)
-  Linear,     // write-up state equation 0 and the paper's footnote 7: k (rho - rho0)
-  Ratio,      // write-up state equation 1: k (rho/rho0 - 1)
-  Seventh,    // write-up state equation 2: k ((rho/rho0)^7 - 1)
+  Tait,     // paper eq. 7: k ((rho/rho0)^gamma - 1)
+  Linear,   // write-up state equation 0 and the paper's footnote 7: k (rho - rho0)
+  Ratio,    // write-up state equation 1: k (rho/rho0 - 1)
+  Seventh,  // write-up state equation 2: k ((rho/rho0)^7 - 1)
 };
 
 std::string_view eos_name(EosKind k);
@@ -30,9 +30,15 @@ struct EquationOfState {
   CELLSPH_HD Real pressure(Real rho, Real rho0) const {
     Real p = 0;
     switch (kind) {
-      case EosKind::Tait: p = stiffness * (std::pow(rho / rho0, gamma) - 1); break;
-      case EosKind::Linear: p = stiffness * (rho - rho0); break;
-      case EosKind::Ratio: p = stiffness * (rho / rho0 - 1); break;
+      case EosKind::Tait:
+        p = stiffness * (std::pow(rho / rho0, gamma) - 1);
+        break;
+      case EosKind::Linear:
+        p = stiffness * (rho - rho0);
+        break;
+      case EosKind::Ratio:
+        p = stiffness * (rho / rho0 - 1);
+        break;
       case EosKind::Seventh: {
         const Real q = rho / rho0, q2 = q * q, q3 = q2 * q;
         p = stiffness * (q3 * q3 * q - 1);
@@ -45,10 +51,14 @@ struct EquationOfState {
   // Speed of sound c = sqrt(dp/drho) at rest density, for the Courant condition (eq. 12).
   Real sound_speed(Real rho0) const {
     switch (kind) {
-      case EosKind::Tait: return std::sqrt(stiffness * gamma / rho0);
-      case EosKind::Linear: return std::sqrt(stiffness);
-      case EosKind::Ratio: return std::sqrt(stiffness / rho0);
-      case EosKind::Seventh: return std::sqrt(Real(7) * stiffness / rho0);
+      case EosKind::Tait:
+        return std::sqrt(stiffness * gamma / rho0);
+      case EosKind::Linear:
+        return std::sqrt(stiffness);
+      case EosKind::Ratio:
+        return std::sqrt(stiffness / rho0);
+      case EosKind::Seventh:
+        return std::sqrt(Real(7) * stiffness / rho0);
     }
     return 0;
   }

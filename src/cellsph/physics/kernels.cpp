@@ -4,11 +4,16 @@ namespace cellsph {
 
 std::string_view kernel_name(KernelKind k) {
   switch (k) {
-    case KernelKind::Poly6: return "poly6";
-    case KernelKind::Spiky: return "spiky";
-    case KernelKind::Viscosity: return "viscosity";
-    case KernelKind::CubicSpline: return "cubic";
-    case KernelKind::WendlandC2: return "wendland";
+    case KernelKind::Poly6:
+      return "poly6";
+    case KernelKind::Spiky:
+      return "spiky";
+    case KernelKind::Viscosity:
+      return "viscosity";
+    case KernelKind::CubicSpline:
+      return "cubic";
+    case KernelKind::WendlandC2:
+      return "wendland";
   }
   return "?";
 }

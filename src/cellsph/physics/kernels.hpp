@@ -16,8 +16,8 @@
 //    works out to W = 40/(pi h^5) [h r^2/4 - r^3/9 - 5h^3/36 + (h^3/6) ln(h/r)], Laplacian 40/(pi h^5)(h-r).
 #include <cmath>
 #include <numbers>
-#include <string_view>
 #include <optional>
+#include <string_view>
 
 #include "cellsph/core/hd.hpp"
 #include "cellsph/core/vec.hpp"
@@ -142,7 +142,8 @@ struct ViscosityKernel {
   CELLSPH_HD Real dW(Real r) const {
     if (r > h) return 0;
     if constexpr (Dim == 3) {
-      return sigma * (Real(-3) * r * r / (Real(2) * h * h * h) + Real(2) * r / (h * h) - h / (Real(2) * r * r));
+      return sigma *
+             (Real(-3) * r * r / (Real(2) * h * h * h) + Real(2) * r / (h * h) - h / (Real(2) * r * r));
     } else {
       return sigma * (h * r / 2 - r * r / 3 - h * h * h / (Real(6) * r));
     }
@@ -236,11 +237,16 @@ struct WendlandC2Kernel {
 template <int Dim, class Real, class F>
 decltype(auto) with_kernel(KernelKind kind, Real h, F&& f) {
   switch (kind) {
-    case KernelKind::Poly6: return f(Poly6Kernel<Dim, Real>(h));
-    case KernelKind::Spiky: return f(SpikyKernel<Dim, Real>(h));
-    case KernelKind::Viscosity: return f(ViscosityKernel<Dim, Real>(h));
-    case KernelKind::CubicSpline: return f(CubicSplineKernel<Dim, Real>(h));
-    case KernelKind::WendlandC2: break;
+    case KernelKind::Poly6:
+      return f(Poly6Kernel<Dim, Real>(h));
+    case KernelKind::Spiky:
+      return f(SpikyKernel<Dim, Real>(h));
+    case KernelKind::Viscosity:
+      return f(ViscosityKernel<Dim, Real>(h));
+    case KernelKind::CubicSpline:
+      return f(CubicSplineKernel<Dim, Real>(h));
+    case KernelKind::WendlandC2:
+      break;
   }
   return f(WendlandC2Kernel<Dim, Real>(h));
 }

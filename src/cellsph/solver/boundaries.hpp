@@ -26,8 +26,8 @@ CELLSPH_HD inline void box_collision(Vec<Dim, Real>& x, Vec<Dim, Real>& v, const
 // (no overshooting), its approaching normal velocity reversed with restitution e (inelastic collision)
 // and its tangential velocity reduced by the fraction `friction` (wet friction).
 template <int Dim, class Real>
-CELLSPH_HD inline void plane_collision(Vec<Dim, Real>& x, Vec<Dim, Real>& v, const Vec<Dim, Real>& n, Real offset,
-                                       Real restitution, Real friction) {
+CELLSPH_HD inline void plane_collision(Vec<Dim, Real>& x, Vec<Dim, Real>& v, const Vec<Dim, Real>& n,
+                                       Real offset, Real restitution, Real friction) {
   const Real d = dot(n, x) - offset;
   if (d >= 0) return;
   x -= n * d;

@@ -46,6 +46,9 @@ void SolverConfig<Dim, Real>::validate() const {
   positive("time.courant", time.courant);
   positive("time.viscous", time.viscous);
   positive("time.force", time.force);
+  if (time.max_level < 0 || time.max_level > 40) bad("time.max_level", time.max_level, "must be in [0, 40]");
+  if (time.mode == TimeStepping::PerParticle && model != Model::PaperMultiphase)
+    bad("time.mode", "per-particle", "per-particle steps need the paper model's leap-frog (model = paper)");
   if (box.enabled) {
     for (int a = 0; a < Dim; ++a)
       if (!(box.hi[a] - 2 * box.radius > box.lo[a]))
@@ -63,16 +66,44 @@ void SolverConfig<Dim, Real>::validate() const {
   if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
 }
 
-std::string_view model_name(Model m) { return m == Model::PaperMultiphase ? "paper" : "wcsph"; }
+std::string_view model_name(Model m) {
+  return m == Model::PaperMultiphase ? "paper" : "wcsph";
+}
 std::optional<Model> parse_model(std::string_view n) {
   if (n == "paper") return Model::PaperMultiphase;
   if (n == "wcsph") return Model::Wcsph;
   return std::nullopt;
 }
-std::string_view time_stepping_name(TimeStepping t) { return t == TimeStepping::Fixed ? "fixed" : "courant"; }
+std::string_view time_stepping_name(TimeStepping t) {
+  switch (t) {
+    case TimeStepping::Fixed:
+      return "fixed";
+    case TimeStepping::Courant:
+      return "courant";
+    case TimeStepping::PerParticle:
+      return "per-particle";
+  }
+  return "?";
+}
 std::optional<TimeStepping> parse_time_stepping(std::string_view n) {
-  if (n == "fixed") return TimeStepping::Fixed;
-  if (n == "courant") return TimeStepping::Courant;
+  for (auto t : {TimeStepping::Fixed, TimeStepping::Courant, TimeStepping::PerParticle})
+    if (time_stepping_name(t) == n) return t;
+  return std::nullopt;
+}
+std::string_view tension_model_name(TensionModel t) {
+  return t == TensionModel::Paper ? "paper" : "csf";
+}
+std::optional<TensionModel> parse_tension_model(std::string_view n) {
+  if (n == "paper") return TensionModel::Paper;
+  if (n == "csf") return TensionModel::Csf;
+  return std::nullopt;
+}
+std::string_view correction_name(StepChangeCorrection c) {
+  return c == StepChangeCorrection::Exact ? "exact" : "printed";
+}
+std::optional<StepChangeCorrection> parse_correction(std::string_view n) {
+  if (n == "exact") return StepChangeCorrection::Exact;
+  if (n == "printed") return StepChangeCorrection::Printed;
   return std::nullopt;
 }
 std::string_view density_formulation_name(DensityFormulation d) {

@@ -26,9 +26,29 @@ enum class DensityFormulation {
   Number,  // Solenthaler & Pajarola 2008: delta_i = sum_j W_ij, rho_i = m_i delta_i, V_i = 1 / delta_i
 };
 
+// How the paper's model turns the colour field into interface tension.
+enum class TensionModel {
+  Paper,  // eq. 9: f = -sigma lap C grad C / |grad C| (Algorithm 1, lines 11-14)
+  // Continuum surface force with the curvature from the divergence of the unit normal (Brackbill 1992,
+  // in SPH as Morris 2000): n = sum_j V_j (c_j - c_i) grad W, kappa = -div(n / |n|), f = sigma kappa n.
+  Csf,
+};
+
 enum class TimeStepping {
   Fixed,    // dt = time.dt every step (the paper's test)
   Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
+  // Per-particle power-of-two steps (Desbrun 1996; eq. 12-13): particle i advances with dt_max / 2^n_i
+  // and is integrated only when the global clock reaches its own time. Paper model only.
+  PerParticle,
+};
+
+// What happens when a particle's step changes from dt_old to dt_new.
+enum class StepChangeCorrection {
+  // Variable-step leap-frog: the kick uses (dt_old + dt_new)/2, which lands the stored velocity on the
+  // new half step; exact under a constant force, no position correction needed.
+  Exact,
+  // Algorithm 1's kick v += dt_new f/m with eq. 13 as printed: r += (dt_new^2 - dt_old^2) / (8 m) f.
+  Printed,
 };
 
 // One fluid (or boundary material): the phases table of a scene.
@@ -69,15 +89,18 @@ struct SolverConfig {
 
   // |grad C| below which no interface tension acts (Mueller 2003's threshold l; the write-up's 7.065).
   Real tension_threshold = 0;
+  TensionModel tension = TensionModel::Paper;
   V gravity = gravity_default();
 
   struct Time {
     TimeStepping mode = TimeStepping::Fixed;
-    Real dt = Real(0.002);    // Fixed: the step [s]
-    Real dt_max = Real(0.01); // Courant: upper bound of the step [s]
-    Real courant = Real(0.3); // alpha of eq. 12
+    Real dt = Real(0.002);       // Fixed: the step [s]
+    Real dt_max = Real(0.01);    // Courant: upper bound of the step [s]
+    Real courant = Real(0.3);    // alpha of eq. 12
     Real viscous = Real(0.125);  // dt <= viscous * h^2 rho0 / mu
     Real force = Real(0.25);     // dt <= force * sqrt(h / |a|max)
+    int max_level = 12;          // PerParticle: finest step dt_max / 2^max_level
+    StepChangeCorrection correction = StepChangeCorrection::Exact;
   } time{};
 
   // The write-up's box: a particle that leaves [lo + r, hi - r] is put back on the wall and its normal
@@ -118,6 +141,10 @@ std::string_view model_name(Model m);
 std::optional<Model> parse_model(std::string_view name);
 std::string_view time_stepping_name(TimeStepping t);
 std::optional<TimeStepping> parse_time_stepping(std::string_view name);
+std::string_view tension_model_name(TensionModel t);
+std::optional<TensionModel> parse_tension_model(std::string_view name);
+std::string_view correction_name(StepChangeCorrection c);
+std::optional<StepChangeCorrection> parse_correction(std::string_view name);
 std::string_view density_formulation_name(DensityFormulation d);
 std::optional<DensityFormulation> parse_density_formulation(std::string_view name);
 

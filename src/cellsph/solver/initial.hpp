@@ -24,8 +24,8 @@ void add_particle(Particles<Dim, Real>& p, const Vec<Dim, Real>& x, std::int32_t
 // Fills [lo, hi] with fluid particles at the centres of a lattice of cells of size `spacing`, each of
 // mass `mass` (0: the phase's mass). Returns the number of particles added.
 template <int Dim, class Real>
-std::size_t add_block(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi, Real spacing,
-                      std::int32_t phase, Real mass = 0) {
+std::size_t add_block(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi,
+                      Real spacing, std::int32_t phase, Real mass = 0) {
   int n[3] = {1, 1, 1};
   for (int a = 0; a < Dim; ++a) n[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / spacing));
   std::size_t added = 0;
@@ -43,9 +43,11 @@ std::size_t add_block(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const V
 
 // Appends `layers` layers of boundary particles (Akinci 2012) on the lattice of add_block around the box
 // [lo, hi]; with open_top the face at hi[Dim-1] is left open (the side walls stop at its height).
+// weight 0 lets the Simulation compute Akinci's psi_b; rho0 spacing^Dim makes a wall at least one support
+// length thick behave like resting fluid.
 template <int Dim, class Real>
 std::size_t add_box_walls(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi,
-                          Real spacing, int layers, bool open_top, std::int32_t phase = 0) {
+                          Real spacing, int layers, bool open_top, std::int32_t phase = 0, Real weight = 0) {
   int n[3] = {1, 1, 1};
   for (int a = 0; a < Dim; ++a) n[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / spacing));
   const int L = layers;
@@ -61,7 +63,7 @@ std::size_t add_box_walls(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, con
         if (open_top && idx[Dim - 1] >= n[Dim - 1]) continue;
         Vec<Dim, Real> x;
         for (int a = 0; a < Dim; ++a) x[a] = lo[a] + (Real(idx[a]) + Real(0.5)) * spacing;
-        add_particle(p, x, phase, ParticleKind::Boundary);
+        add_particle(p, x, phase, ParticleKind::Boundary, weight);
         ++added;
       }
   return added;

@@ -30,6 +30,7 @@ struct Particles {
   std::vector<Real> mu;    // dynamic viscosity [Pa s]
   std::vector<std::int32_t> phase;  // phase index into the scene's phase table
   std::vector<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
+  std::vector<std::int64_t> tick;   // per-particle steps: state time in units of dt_max / 2^max_level
   std::vector<std::uint8_t> kind;   // ParticleKind: fluid (integrated) or boundary (static, Akinci 2012)
 
   // The field list. f(name, vector) for every field, in a fixed order.
@@ -46,6 +47,7 @@ struct Particles {
     fn(std::string_view("viscosity"), self.mu);
     fn(std::string_view("phase"), self.phase);
     fn(std::string_view("level"), self.level);
+    fn(std::string_view("tick"), self.tick);
     fn(std::string_view("kind"), self.kind);
   }
   template <class F>

@@ -37,11 +37,14 @@ class Simulation {
   // Validates the config (InputError) and completes the particles: x, v, m, phase and kind are the inputs
   // (v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid particle:
   // the phase's mass). support, colour and viscosity are set from the config and the phase table,
-  // density to the rest density; boundary particles get their Akinci weight psi_b in m.
+  // density to the rest density; boundary particles with m == 0 get their Akinci weight psi_b in m (a
+  // positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick,
+  // m = rho0 spacing^Dim makes the wall look exactly like fluid).
   Simulation(Config config, Particles<Dim, Real> particles);
 
-  // One time step of the configured model. Throws SimulationError (step, particle, quantity, value) when
-  // a particle's state is not finite or leaves the domain.
+  // One time step of the configured model (with per-particle steps: advances the particles whose own
+  // time is the global clock, then the clock to the next such time). Throws SimulationError (step, particle,
+  // quantity, value) when a particle's state is not finite or leaves the domain.
   void step();
   // Steps until time() >= t_end (the last step is not shortened).
   void run_until(Real t_end);
@@ -66,12 +69,13 @@ class Simulation {
   void save_state(std::ostream& out) const;
   void load_state(std::istream& in);
 
-  static constexpr std::uint32_t kStateVersion = 1;
+  static constexpr std::uint32_t kStateVersion = 2;  // 2: the per-particle "tick" field
 
  private:
   void compute_neighbors();
   void compute_density_pressure();
   void compute_forces_paper();
+  void compute_normals();
   void compute_forces_wcsph();
   Real choose_dt() const;
   void integrate_paper(Real dt);
@@ -79,13 +83,18 @@ class Simulation {
   void apply_walls();
   void check_state() const;
   void init_boundary_weights();
+  void step_per_particle();
+  Real particle_dt(std::size_t i) const;
 
   Config cfg_;
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
-  std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
-  std::vector<Real> rho0_;     // rest density per particle (from its phase)
+  std::vector<V> normal_;          // CSF: colour gradient n_i of the current step
+  std::vector<V> f_pressure_;      // WCSPH: pressure force, applied after the predicted velocity
+  std::vector<Real> rho0_;         // rest density per particle (from its phase)
+  std::vector<V> xs_;              // per-particle steps: every position extrapolated to the global clock
+  std::vector<std::uint8_t> due_;  // per-particle steps: 1 for the particles integrated this step
   bool any_tension_ = false;
   std::size_t fluid_count_ = 0;
 

@@ -1,0 +1,616 @@
+// Solver tests against independent references: conservation laws, hydrostatics (rho g H), bit-for-bit
+// determinism and checkpoint/resume. Small particle counts with the all-pairs reference search.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <sstream>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/solver/boundaries.hpp"
+#include "cellsph/solver/initial.hpp"
+#include "cellsph/solver/simulation.hpp"
+
+namespace cellsph {
+namespace {
+
+using V2 = Vec<2, double>;
+
+// A free blob of fluid (no walls, no gravity) with jittered positions and random velocities.
+Particles<2, double> blob(int nx, double s, std::uint32_t seed, int phases = 1) {
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{nx * s, nx * s}}, s, 0);
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.x[i] += V2{{u(gen), u(gen)}} * (0.1 * s);
+    p.v[i] = V2{{u(gen), u(gen)}} * 0.5;
+    if (phases > 1 && p.x[i][0] > nx * s / 2) p.phase[i] = 1;
+  }
+  return p;
+}
+
+SolverConfig<2, double> base_config(Model model) {
+  SolverConfig<2, double> c;
+  c.model = model;
+  c.search.method = Method::AllPairs;
+  c.support = 0.05;
+  c.gravity = V2{};
+  c.phases[0].rest_density = 1000;
+  c.phases[0].mass = 1000 * 0.02 * 0.02;
+  c.phases[0].viscosity = 1;
+  c.eos.kind = EosKind::Tait;
+  c.eos.stiffness = 2000;
+  c.time.dt = 2e-4;
+  if (model == Model::Wcsph) {
+    c.density_kernel = KernelKind::CubicSpline;
+    c.pressure_kernel = KernelKind::CubicSpline;
+    c.eos.kind = EosKind::Ratio;
+    c.eos.stiffness = 2e4;
+  }
+  return c;
+}
+
+template <int Dim, class Real>
+bool same_state(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
+  bool same = a.size() == b.size();
+  a.for_each_field([&](std::string_view name, const auto& fa) {
+    b.for_each_field([&](std::string_view nb, const auto& fb) {
+      if constexpr (std::is_same_v<decltype(fa), decltype(fb)>) {
+        if (name == nb)
+          same = same && fa.size() == fb.size() &&
+                 std::memcmp(fa.data(), fb.data(), fa.size() * sizeof(fa[0])) == 0;
+      }
+    });
+  });
+  return same;
+}
+
+class BothModels : public ::testing::TestWithParam<Model> {};
+
+TEST_P(BothModels, MassConservedExactly) {
+  ScopedThreads one(1);  // small runs; thread independence is tested separately
+  auto cfg = base_config(GetParam());
+  Simulation<2, double> sim(cfg, blob(8, 0.02, 1));
+  const double m0 = sim.total_mass();
+  const auto masses = sim.particles().m;
+  for (int s = 0; s < 30; ++s) sim.step();
+  EXPECT_EQ(sim.total_mass(), m0);
+  EXPECT_EQ(sim.particles().m, masses);
+  EXPECT_EQ(sim.particles().size(), 64u);
+}
+
+TEST_P(BothModels, LinearMomentumConservedToRoundOff) {
+  ScopedThreads one(1);  // small runs; thread independence is tested separately
+  // Pairwise antisymmetric forces (eq. 8a-b averaged; the write-up's symmetric pressure and Monaghan
+  // viscosity) leave sum m v unchanged up to the rounding of the per-particle sums.
+  auto cfg = base_config(GetParam());
+  cfg.phases.push_back(cfg.phases[0]);
+  cfg.phases[1].viscosity = 3;
+  cfg.phases[1].mass *= 1.5;  // a second phase with other mass and viscosity
+  Simulation<2, double> sim(cfg, blob(9, 0.02, 7, 2));
+  const V2 p0 = sim.momentum();
+  double scale = 0;
+  for (std::size_t i = 0; i < sim.particles().size(); ++i)
+    scale += sim.particles().m[i] * norm(sim.particles().v[i]);
+  double max_f = 0;
+  for (int s = 0; s < 60; ++s) {
+    sim.step();
+    for (const auto& f : sim.particles().f) max_f = std::max(max_f, norm(f));
+  }
+  const V2 p1 = sim.momentum();
+  // Forces must not be trivially zero for this to mean anything.
+  EXPECT_GT(max_f * sim.last_dt() * 60, 1e-3 * scale);
+  EXPECT_LT(norm(p1 - p0), 1e-12 * scale)
+      << "p0 = " << p0[0] << "," << p0[1] << " p1 = " << p1[0] << "," << p1[1];
+}
+
+TEST_P(BothModels, BitIdenticalAcrossRunsAndThreadCounts) {
+  auto cfg = base_config(GetParam());
+  cfg.phases[0].sigma = 0.5;  // exercise the colour field too
+  cfg.box.enabled = true;
+  cfg.box.lo = V2{{-0.05, -0.05}};
+  cfg.box.hi = V2{{0.25, 0.25}};
+  cfg.gravity = SolverConfig<2, double>::gravity_default();
+  auto run = [&](int threads) {
+    ScopedThreads t(threads);
+    Simulation<2, double> sim(cfg, blob(8, 0.02, 3));
+    for (int s = 0; s < 20; ++s) sim.step();
+    return sim.particles();
+  };
+  const auto a = run(1), b = run(1), c = run(2);
+  EXPECT_TRUE(same_state(a, b));
+  EXPECT_TRUE(same_state(a, c));
+}
+
+TEST_P(BothModels, CheckpointResumeIsBitIdentical) {
+  ScopedThreads one(1);  // small runs; thread independence is tested separately
+  auto cfg = base_config(GetParam());
+  cfg.time.mode = TimeStepping::Courant;
+  cfg.time.dt_max = 1e-3;
+  cfg.gravity = SolverConfig<2, double>::gravity_default();
+  cfg.planes.push_back({V2{{0, 1}}, -0.02});
+  Simulation<2, double> full(cfg, blob(8, 0.02, 5));
+  for (int s = 0; s < 25; ++s) full.step();
+  std::stringstream state;
+  full.save_state(state);
+  for (int s = 0; s < 25; ++s) full.step();
+
+  Simulation<2, double> resumed(cfg, blob(8, 0.02, 5));
+  resumed.load_state(state);
+  EXPECT_EQ(resumed.steps(), 25u);
+  for (int s = 0; s < 25; ++s) resumed.step();
+  EXPECT_TRUE(same_state(full.particles(), resumed.particles()));
+  EXPECT_EQ(full.time(), resumed.time());
+  EXPECT_EQ(full.steps(), resumed.steps());
+}
+
+INSTANTIATE_TEST_SUITE_P(Solver, BothModels, ::testing::Values(Model::PaperMultiphase, Model::Wcsph),
+                         [](const ::testing::TestParamInfo<Model>& pi) {
+                           return std::string(model_name(pi.param));
+                         });
+
+TEST(Checkpoint, RejectsMismatchedState) {
+  auto cfg = base_config(Model::Wcsph);
+  Simulation<2, double> a(cfg, blob(4, 0.02, 1));
+  Simulation<2, double> b(cfg, blob(5, 0.02, 1));
+  std::stringstream s;
+  a.save_state(s);
+  EXPECT_THROW(b.load_state(s), InputError);
+  std::stringstream junk("not a checkpoint");
+  EXPECT_THROW(a.load_state(junk), InputError);
+}
+
+TEST(Solver, LeapfrogHalfStepInitialisation) {
+  // A single particle under gravity: with v(t0 - dt/2) initialised, leap-frog is exact for constant
+  // acceleration: x(t) = x0 + v0 t + g t^2 / 2 at every step.
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.gravity = V2{{0, -9.81}};
+  cfg.time.dt = 0.01;
+  Particles<2, double> p;
+  add_particle<2, double>(p, V2{{0, 0}}, 0, ParticleKind::Fluid, 0, V2{{1, 2}});
+  Simulation<2, double> sim(cfg, p);
+  for (int s = 0; s < 50; ++s) sim.step();
+  const double t = sim.time();
+  EXPECT_NEAR(sim.particles().x[0][0], 1 * t, 1e-12);
+  EXPECT_NEAR(sim.particles().x[0][1], 2 * t - 9.81 * t * t / 2, 1e-12);
+}
+
+TEST(Solver, UnstableRunStopsWithDiagnosis) {
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.time.dt = 0.5;  // far beyond eq. 12
+  cfg.eos.stiffness = 1e7;
+  cfg.domain_set = true;
+  cfg.domain_lo = V2{{-1, -1}};
+  cfg.domain_hi = V2{{1, 1}};
+  Simulation<2, double> sim(cfg, blob(6, 0.02, 2));
+  try {
+    for (int s = 0; s < 20; ++s) sim.step();
+    FAIL() << "no SimulationError";
+  } catch (const SimulationError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("step "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("particle "), std::string::npos) << msg;
+  }
+}
+
+TEST(Solver, RejectsBadInput) {
+  auto cfg = base_config(Model::Wcsph);
+  cfg.support = -1;
+  auto make = [&] { Simulation<2, double> sim(cfg, blob(3, 0.02, 1)); };
+  EXPECT_THROW(make(), InputError);
+  cfg = base_config(Model::Wcsph);
+  auto p = blob(3, 0.02, 1);
+  p.phase[4] = 7;
+  try {
+    Simulation<2, double> sim(cfg, p);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("particle 4 has phase 7"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Walls, PlaneCollisionProjectsReflectsAndRubs) {
+  V2 x{{0.3, -0.01}}, v{{2, -1}};
+  plane_collision<2, double>(x, v, V2{{0, 1}}, 0.0, 0.5, 0.25);
+  EXPECT_DOUBLE_EQ(x[1], 0.0);       // projected onto the wall
+  EXPECT_DOUBLE_EQ(v[1], 0.5);       // -e vn
+  EXPECT_DOUBLE_EQ(v[0], 2 * 0.75);  // wet friction
+  V2 y{{0.3, 0.2}}, w{{2, -1}};
+  plane_collision<2, double>(y, w, V2{{0, 1}}, 0.0, 0.5, 0.25);
+  EXPECT_EQ(w, (V2{{2, -1}}));  // no contact, no change
+}
+
+TEST(Walls, BoxClampsAndDamps) {
+  V2 x{{1.2, -1.3}}, v{{3, -4}};
+  box_collision<2, double>(x, v, V2{{-1, -1}}, V2{{1, 1}}, 0.01, -0.5);
+  EXPECT_DOUBLE_EQ(x[0], 0.99);
+  EXPECT_DOUBLE_EQ(x[1], -0.99);
+  EXPECT_DOUBLE_EQ(v[0], -1.5);
+  EXPECT_DOUBLE_EQ(v[1], 2.0);
+}
+
+// Hydrostatic tank (2D, WCSPH, boundary particles): after settling, the mean density is within 1% of rest
+// density and the pressure of the bottom row within 5% of rho0 g (H - y). Both are averaged over the
+// steps of the window [0.5 s, 1 s]: the weakly compressible column keeps ringing acoustically (period
+// 4H/c = 0.05 s) at an amplitude of a few percent, and the mean over many periods is the state it rings
+// about.
+TEST(Hydrostatic, TankSettlesToRhoGH) {
+  const double s = 0.02, W = 0.2, H = 0.3, rho0 = 1000, g = 9.81;
+  SolverConfig<2, double> cfg;
+  cfg.model = Model::Wcsph;
+  cfg.search.method = Method::AllPairs;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.pressure_kernel = KernelKind::CubicSpline;
+  cfg.support = 2 * s;
+  cfg.phases[0].rest_density = rho0;
+  cfg.phases[0].mass = rho0 * s * s;
+  cfg.phases[0].viscosity = 20;
+  const double c = 10 * std::sqrt(2 * g * H);  // Mach 0.1 for the fastest free-fall speed
+  cfg.eos.kind = EosKind::Ratio;
+  cfg.eos.stiffness = rho0 * c * c;
+  cfg.eos.clamp_negative = true;
+  cfg.time.mode = TimeStepping::Courant;
+  cfg.time.dt_max = 1e-3;
+  cfg.domain_set = true;
+  cfg.domain_lo = V2{{-0.1, -0.1}};
+  cfg.domain_hi = V2{{W + 0.1, 2 * H}};
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{W, H}}, s, 0);
+  // Walls on the fluid's lattice, as thick as the support, weighted like fluid.
+  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{W, H + 2 * s}}, s, 2, true, 0, rho0 * s * s);
+  ScopedThreads one(1);  // ~400 particles: thread start-up would dominate
+  Simulation<2, double> sim(cfg, p);
+  sim.run_until(0.5);
+
+  double rho_mean = 0, p_bottom = 0, ref_bottom = 0;
+  int samples = 0;
+  while (sim.time() < 1.0) {
+    sim.step();
+    const auto& q = sim.particles();
+    double rho_sum = 0, pb = 0, rb = 0;
+    int nf = 0, nb = 0;
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      if (q.kind[i] != 0) continue;
+      rho_sum += q.rho[i];
+      ++nf;
+      if (q.x[i][1] < s) {
+        pb += q.p[i];
+        rb += rho0 * g * (H - q.x[i][1]);
+        ++nb;
+      }
+    }
+    ASSERT_GT(nb, 0);
+    rho_mean += rho_sum / nf;
+    p_bottom += pb / nb;
+    ref_bottom += rb / nb;
+    ++samples;
+  }
+  rho_mean /= samples;
+  p_bottom /= samples;
+  ref_bottom /= samples;
+  EXPECT_NEAR(rho_mean, rho0, 0.01 * rho0);
+  EXPECT_NEAR(p_bottom, ref_bottom, 0.05 * ref_bottom);
+  EXPECT_LT(sim.kinetic_energy(), 1e-3 * sim.total_mass() * g * H) << "not settled";
+  std::cout << "[hydrostatic] steps " << sim.steps() << " mean rho " << rho_mean << " bottom p " << p_bottom
+            << " ref " << ref_bottom << " KE " << sim.kinetic_energy() << "\n";
+}
+
+// 2D dam break of Koshizuka & Oka (1996): a 1 m x 2 m water column in a 4 m tank. The surge front (the
+// largest x of a fluid particle plus half a spacing) must be within 10% of every published point up to
+// T = t sqrt(2g/a) = 3. WCSPH with wall particles; the viscosity is the usual artificial one,
+// mu = rho0 alpha h c / (2(d+2)) with alpha = 0.02. At this coarse spacing (0.1 m, 200 fluid particles) the
+// worst error measured is about 7%; at 0.05 m it is about 12.5% (the simulated front leads the
+// experiment between T = 1 and 2), so this is a check of the set-up at CI resolution, not a convergence
+// claim.
+TEST(DamBreak, KoshizukaOkaSurgeFront) {
+  const double s = 0.1, rho0 = 1000, g = 9.81, a = 1.0;
+  SolverConfig<2, double> cfg;
+  cfg.model = Model::Wcsph;
+  cfg.search.method = Method::AllPairs;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.pressure_kernel = KernelKind::CubicSpline;
+  cfg.support = 2 * s;
+  const double c = 10 * std::sqrt(2 * g * 2 * a);
+  cfg.phases[0].rest_density = rho0;
+  cfg.phases[0].mass = rho0 * s * s;
+  cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / (2 * (2 + 2));
+  cfg.eos.kind = EosKind::Ratio;
+  cfg.eos.stiffness = rho0 * c * c;
+  cfg.eos.clamp_negative = true;
+  cfg.time.mode = TimeStepping::Courant;
+  cfg.time.dt_max = 1e-3;
+  cfg.domain_set = true;
+  cfg.domain_lo = V2{{-0.5, -0.5}};
+  cfg.domain_hi = V2{{4 * a + 0.5, 4}};
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{a, 2 * a}}, s, 0);
+  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{4 * a, 3 * a}}, s, 2, true, 0, rho0 * s * s);
+
+  // Read the published front positions (t [s], x [m]).
+  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/../../shared/validation/koshizuka_oka_1996_front.tsv");
+  if (!in) in.open("/work/shared/validation/koshizuka_oka_1996_front.tsv");
+  ASSERT_TRUE(in) << "koshizuka_oka_1996_front.tsv not found";
+  std::vector<std::pair<double, double>> ref;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    double t = 0, x = 0;
+    ls >> t >> x;
+    if (t * std::sqrt(2 * g / a) <= 3) ref.emplace_back(t, x);
+  }
+  ASSERT_GE(ref.size(), 10u);
+
+  ScopedThreads one(1);
+  Simulation<2, double> sim(cfg, p);
+  double worst = 0;
+  for (const auto& [t, x] : ref) {
+    sim.run_until(t);
+    double front = 0;
+    for (std::size_t i = 0; i < sim.particles().size(); ++i)
+      if (sim.particles().kind[i] == 0) front = std::max(front, sim.particles().x[i][0]);
+    front += s / 2;
+    worst = std::max(worst, std::abs(front - x) / x);
+    EXPECT_NEAR(front, x, 0.1 * x) << "t = " << sim.time() << " s";
+  }
+  std::cout << "[dam break] worst front error " << 100 * worst << "% over " << ref.size() << " points\n";
+}
+
+// The same conservation law in 3D and in single precision (a smoke test of the other instantiations).
+TEST(Solver3D, MomentumConservedBothModels) {
+  for (Model model : {Model::PaperMultiphase, Model::Wcsph}) {
+    SolverConfig<3, float> cfg;
+    cfg.model = model;
+    cfg.search.method = Method::AllPairs;
+    cfg.support = 0.05f;
+    cfg.gravity = Vec<3, float>{};
+    cfg.phases[0].mass = 1000 * 0.02f * 0.02f * 0.02f;
+    cfg.phases[0].viscosity = 1;
+    cfg.eos.stiffness = 2000;
+    cfg.time.dt = 2e-4f;
+    Particles<3, float> p;
+    add_block<3, float>(p, Vec<3, float>{}, Vec<3, float>{{0.1f, 0.1f, 0.1f}}, 0.02f, 0);
+    std::mt19937 gen(3);
+    std::uniform_real_distribution<float> u(-1, 1);
+    for (auto& v : p.v) v = Vec<3, float>{{u(gen), u(gen), u(gen)}};
+    ScopedThreads one(1);
+    Simulation<3, float> sim(cfg, p);
+    const auto p0 = sim.momentum();
+    for (int k = 0; k < 20; ++k) sim.step();
+    EXPECT_LT(norm(sim.momentum() - p0), 1e-5f * sim.total_mass()) << model_name(model);
+    EXPECT_GT(sim.particles().rho[0], 0.0f);
+  }
+}
+
+// Per-particle power-of-two steps: one particle falling under gravity speeds up, so eq. 12 refines its
+// level several times. With the Exact step-change correction its position stays on the parabola to
+// round-off; eq. 13 as printed drifts off it (the difference is reported, not hidden).
+double falling_particle_error(StepChangeCorrection corr, int* levels_seen) {
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.gravity = V2{{0, -9.81}};
+  cfg.eos.stiffness = 1e-3;  // sound speed ~0: eq. 12's velocity term decides the level
+  cfg.time.mode = TimeStepping::PerParticle;
+  cfg.time.dt_max = 0.01;
+  cfg.time.max_level = 10;
+  cfg.time.force = 100;  // keep the force limit out of the way
+  cfg.time.correction = corr;
+  Particles<2, double> p;
+  add_particle<2, double>(p, V2{{0, 0}}, 0, ParticleKind::Fluid, 0, V2{{1, 2}});
+  ScopedThreads one(1);
+  Simulation<2, double> sim(cfg, p);
+  double worst = 0;
+  int lo = 99, hi = -1;
+  while (sim.time() < 1.0) {
+    sim.step();
+    const double t = static_cast<double>(sim.particles().tick[0]) * 0.01 / 1024;
+    const auto& x = sim.particles().x[0];
+    worst = std::max({worst, std::abs(x[0] - t), std::abs(x[1] - (2 * t - 9.81 * t * t / 2))});
+    lo = std::min(lo, sim.particles().level[0]);
+    hi = std::max(hi, sim.particles().level[0]);
+  }
+  *levels_seen = hi - lo + 1;
+  return worst;
+}
+
+TEST(PerParticleSteps, StepChangesKeepConstantAccelerationExact) {
+  int levels = 0;
+  const double exact = falling_particle_error(StepChangeCorrection::Exact, &levels);
+  EXPECT_GE(levels, 3) << "the test must change level";
+  EXPECT_LT(exact, 1e-10);
+  const double printed = falling_particle_error(StepChangeCorrection::Printed, &levels);
+  std::cout << "[per-particle] max position error: exact correction " << exact << " m, eq. 13 as printed "
+            << printed << " m\n";
+  EXPECT_GT(printed, 1e-6);
+}
+
+TEST(PerParticleSteps, CheckpointResumeIsBitIdentical) {
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.gravity = SolverConfig<2, double>::gravity_default();
+  cfg.time.mode = TimeStepping::PerParticle;
+  cfg.time.dt_max = 2e-3;
+  cfg.time.max_level = 8;
+  ScopedThreads one(1);
+  Simulation<2, double> full(cfg, blob(8, 0.02, 9));
+  for (int s = 0; s < 30; ++s) full.step();
+  std::stringstream state;
+  full.save_state(state);
+  for (int s = 0; s < 30; ++s) full.step();
+  Simulation<2, double> resumed(cfg, blob(8, 0.02, 9));
+  resumed.load_state(state);
+  for (int s = 0; s < 30; ++s) resumed.step();
+  EXPECT_TRUE(same_state(full.particles(), resumed.particles()));
+  EXPECT_EQ(full.time(), resumed.time());
+}
+
+TEST(PerParticleSteps, RejectedForWcsph) {
+  auto cfg = base_config(Model::Wcsph);
+  cfg.time.mode = TimeStepping::PerParticle;
+  auto make = [&] { Simulation<2, double> sim(cfg, blob(3, 0.02, 1)); };
+  EXPECT_THROW(make(), InputError);
+}
+
+// Two fluids of rest density 1000 and 2000 on one lattice (masses rho0 s^2), at rest. Eq. 7 sums masses,
+// so next to the interface the light fluid is given up to half the heavy one's density and vice versa; the
+// number density of Solenthaler & Pajarola (2008) gives each particle its own rest density. Reference:
+// the rest densities themselves (an unstrained lattice), measured on particles at least h from the edge
+// of the block.
+double worst_density_error(DensityFormulation d) {
+  const double s = 0.02;
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.density = d;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.support = 2 * s;
+  cfg.phases.push_back(cfg.phases[0]);
+  cfg.phases[1].rest_density = 2000;
+  cfg.phases[1].mass = 2000 * s * s;
+  cfg.phases[0].mass = 1000 * s * s;
+  cfg.time.dt = 1e-6;
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{0.4, 0.4}}, s, 0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.x[i][1] > 0.2) p.phase[i] = 1;
+  ScopedThreads one(1);
+  Simulation<2, double> sim(cfg, p);
+  sim.step();
+  const auto& q = sim.particles();
+  double worst = 0;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const auto& x = q.x[i];
+    if (x[0] < 2 * s || x[0] > 0.4 - 2 * s || x[1] < 2 * s || x[1] > 0.4 - 2 * s) continue;
+    const double rho0 = cfg.phases[static_cast<std::size_t>(q.phase[i])].rest_density;
+    worst = std::max(worst, std::abs(q.rho[i] - rho0) / rho0);
+  }
+  return worst;
+}
+
+TEST(TwoPhase, NumberDensityKeepsTheDensityJumpSharp) {
+  const double mass = worst_density_error(DensityFormulation::Mass);
+  const double number = worst_density_error(DensityFormulation::Number);
+  std::cout << "[two-phase] worst density error at the interface: eq. 7 " << 100 * mass
+            << "%, number density " << 100 * number << "%\n";
+  EXPECT_GT(mass, 0.1);
+  EXPECT_LT(number, 0.01);
+}
+
+// The paper's walls in a run: a blob dropped into a box of four planes (inelastic collision, wet friction,
+// projection) never ends a step outside, and its energy falls (collisions and friction only remove it).
+TEST(Walls, PaperPlanesHoldAFallingBlob) {
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.gravity = SolverConfig<2, double>::gravity_default();
+  cfg.planes = {{V2{{0, 1}}, -0.3}, {V2{{1, 0}}, -0.05}, {V2{{-1, 0}}, -0.25}};
+  cfg.domain_set = true;
+  cfg.domain_lo = V2{{-0.05, -0.3}};
+  cfg.domain_hi = V2{{0.25, 0.3}};
+  ScopedThreads one(1);
+  Simulation<2, double> sim(cfg, blob(8, 0.02, 4));
+  auto energy = [&] {
+    double e = sim.kinetic_energy();
+    for (std::size_t i = 0; i < sim.particles().size(); ++i)
+      e += sim.particles().m[i] * 9.81 * (sim.particles().x[i][1] + 0.3);
+    return e;
+  };
+  const double e0 = energy();
+  for (int s = 0; s < 2500; ++s) {
+    sim.step();
+    for (const auto& x : sim.particles().x) {
+      ASSERT_GE(x[1], -0.3) << "step " << s;
+      ASSERT_GE(x[0], -0.05);
+      ASSERT_LE(x[0], 0.25);
+    }
+  }
+  EXPECT_LT(energy(), e0);
+  EXPECT_GT(sim.time(), 0.49);  // it really fell onto the floor (free fall from y = 0 takes 0.25 s)
+}
+
+// Single and double precision follow the same trajectory closely over a short run.
+TEST(Solver, FloatTracksDouble) {
+  auto cd = base_config(Model::Wcsph);
+  SolverConfig<2, float> cf;
+  cf.model = Model::Wcsph;
+  cf.search.method = Method::AllPairs;
+  cf.support = 0.05f;
+  cf.gravity = Vec<2, float>{};
+  cf.phases[0].mass = static_cast<float>(cd.phases[0].mass);
+  cf.phases[0].viscosity = 1;
+  cf.density_kernel = cd.density_kernel;
+  cf.pressure_kernel = cd.pressure_kernel;
+  cf.eos.kind = cd.eos.kind;
+  cf.eos.stiffness = static_cast<float>(cd.eos.stiffness);
+  cf.time.dt = static_cast<float>(cd.time.dt);
+  const auto pd = blob(6, 0.02, 8);
+  Particles<2, float> pf;
+  for (std::size_t i = 0; i < pd.size(); ++i)
+    add_particle<2, float>(pf,
+                           Vec<2, float>{{static_cast<float>(pd.x[i][0]), static_cast<float>(pd.x[i][1])}}, 0,
+                           ParticleKind::Fluid, 0,
+                           Vec<2, float>{{static_cast<float>(pd.v[i][0]), static_cast<float>(pd.v[i][1])}});
+  ScopedThreads one(1);
+  Simulation<2, double> sd(cd, pd);
+  Simulation<2, float> sf(cf, pf);
+  for (int s = 0; s < 50; ++s) {
+    sd.step();
+    sf.step();
+  }
+  double worst = 0;
+  for (std::size_t i = 0; i < pd.size(); ++i)
+    for (int a = 0; a < 2; ++a)
+      worst = std::max(worst, std::abs(static_cast<double>(sf.particles().x[i][a]) - sd.particles().x[i][a]));
+  EXPECT_LT(worst, 1e-5);  // metres, after particles moved ~5 mm
+}
+
+// Interface tension on a disc of fluid 1 (colour 1) in fluid 0 (colour 0), both at rest on a lattice with
+// no pressure: integrating a continuum surface force sigma kappa n delta over the upper half of a circle
+// of radius R gives sigma (1/R) (2R) = 2 sigma, pointing down (in 2D, independent of R). Sum of the
+// particle forces over y > centre, against that reference. Eq. 9 as printed is reported, not asserted:
+// its lap C carries the normal derivative of |grad C|, which does not integrate to the curvature term
+// (measured about twice the reference).
+double half_disc_tension(TensionModel model) {
+  const double s = 0.01, L = 0.3, R = 0.08, sigma = 1;
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.support = 3 * s;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.pressure_kernel = KernelKind::CubicSpline;
+  cfg.eos.kind = EosKind::Ratio;
+  cfg.eos.stiffness = 1e-9;  // no pressure: the force is the tension alone
+  cfg.phases[0].mass = 1000 * s * s;
+  cfg.phases[0].viscosity = 0;
+  cfg.phases[0].color = 0;
+  cfg.phases[0].sigma = sigma;
+  cfg.phases.push_back(cfg.phases[0]);
+  cfg.phases[1].color = 1;
+  cfg.tension = model;
+  cfg.tension_threshold = 0;
+  cfg.time.dt = 1e-9;
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 0);
+  const V2 c{{L / 2, L / 2}};
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (norm(p.x[i] - c) < R) p.phase[i] = 1;
+  ScopedThreads one(1);
+  Simulation<2, double> sim(cfg, p);
+  sim.step();
+  V2 f{};
+  for (std::size_t i = 0; i < sim.particles().size(); ++i)
+    if (sim.particles().x[i][1] > c[1]) f += sim.particles().f[i];
+  // Symmetric about the vertical axis (eq. 9 normalises the noise of grad C deep inside a phase, so only
+  // the CSF force, exactly zero there, is symmetric to round-off).
+  if (model == TensionModel::Csf) {
+    EXPECT_NEAR(f[0], 0, 1e-9);
+  }
+  return f[1];
+}
+
+TEST(InterfaceTension, HalfDiscForceMatchesTwoSigma) {
+  const double csf = half_disc_tension(TensionModel::Csf);
+  const double paper = half_disc_tension(TensionModel::Paper);
+  std::cout << "[tension] half-disc force (reference -2 N/m): CSF " << csf << ", eq. 9 " << paper << "\n";
+  EXPECT_NEAR(csf, -2.0, 0.2);  // within 10%: measured -1.89 (h = 3 spacings, R = 8 spacings)
+}
+
+}  // namespace
+}  // namespace cellsph
