@@ -182,6 +182,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
     }
     if (sr.has("gravity")) cfg.gravity = to_vec<Dim, Real>(sr.vector("gravity", Dim, {}));
     cfg.tension_threshold = static_cast<Real>(sr.number("tension_threshold", 0, 0, 1e12));
+    cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf"}));
     cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
     cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
     sr.finish();
@@ -193,7 +194,12 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   if (r.has("time")) {
     auto tr = r.child("time");
     s.output.end_time = tr.number("end", s.output.end_time, 1e-12, 1e9);
-    cfg.time.mode = *parse_time_stepping(tr.choice("stepping", "courant", {"fixed", "courant"}));
+    cfg.time.mode =
+        *parse_time_stepping(tr.choice("stepping", "courant", {"fixed", "courant", "per-particle"}));
+    if (cfg.time.mode == TimeStepping::PerParticle && cfg.model != Model::PaperMultiphase)
+      tr.fail("stepping", "\"per-particle\" needs the paper model (/solver/model = \"paper\")");
+    cfg.time.max_level = static_cast<int>(tr.integer("max_level", cfg.time.max_level, 0, 30));
+    cfg.time.correction = *parse_correction(tr.choice("correction", "exact", {"exact", "printed"}));
     cfg.time.dt = static_cast<Real>(tr.number("dt", double(cfg.time.dt), 1e-12, 10));
     cfg.time.dt_max = static_cast<Real>(tr.number("dt_max", double(cfg.time.dt_max), 1e-12, 10));
     cfg.time.courant = static_cast<Real>(tr.number("courant", double(cfg.time.courant), 1e-6, 2));
@@ -258,9 +264,14 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
       const auto b = read_box<Dim>(wr);
       const int layers = static_cast<int>(wr.integer("layers", 3, 1, 10));
       const bool open_top = wr.boolean("open_top", true);
+      // "akinci": the Simulation computes each wall particle's psi_b (Akinci 2012); "volume":
+      // rest_density * spacing^dim, right when the wall is at least one support length thick.
+      const bool volume = wr.choice("weight", "akinci", {"akinci", "volume"}) == "volume";
       wr.finish();
+      const Real weight =
+          volume ? cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim)) : Real(0);
       add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
-                    open_top);
+                    open_top, 0, weight);
       container = b;
     }
     if (br.has("obstacles")) {
