@@ -164,25 +164,48 @@ class SpatialHash {
   std::uint64_t for_each_pair(F&& f) const {
     const auto count = static_cast<std::int64_t>(x_.size());
     std::uint64_t tests = 0;
-#pragma omp parallel for schedule(static) reduction(+ : tests)
-    for (std::int64_t ii = 0; ii < count; ++ii) {
-      const auto i = static_cast<std::uint32_t>(ii);
-      const Point xi = x_[i];
-      const Real hi2 = h_[i] * h_[i];
-      const double reach = frame_.reach(h_[i]);
-      const Cell home = frame_.cell_of(xi);
-      for (const MaskCell<Dim>& m : mask_) {
-        if (!mask_keeps(m.gap2, reach)) continue;
-        Cell c;
-        for (int k = 0; k < Dim; ++k) c[k] = home[k] + m.offset[k];
-        if (!frame_.inside(c)) continue;  // no particle lives outside the bounding box
-        const std::uint32_t b = bucket(c);
-        for (std::uint32_t e = start_[b], end = start_[b + 1]; e < end; ++e) {
-          const Entry& en = entries_[e];
-          if (en.cell != c || en.index == i) continue;  // another cell sharing the bucket
-          ++tests;
-          const Real r2 = distance2(xi, en.x);
-          if (r2 <= hi2) f(i, en.index, r2);
+#pragma omp parallel reduction(+ : tests)
+    {
+      // The mask cells of one particle hash to scattered buckets: every bucket is a likely cache
+      // miss (the cost the paper attributes to Spatial Hashing). Their addresses are all known up
+      // front, so they are gathered first and prefetched, then the buckets are scanned.
+      struct Visit {
+        Cell cell;
+        std::uint32_t begin, end;
+      };
+      std::vector<Visit> visits;
+      visits.reserve(mask_.size());
+#pragma omp for schedule(static)
+      for (std::int64_t ii = 0; ii < count; ++ii) {
+        const auto i = static_cast<std::uint32_t>(ii);
+        const Point xi = x_[i];
+        const Real hi2 = h_[i] * h_[i];
+        const double reach = frame_.reach(h_[i]);
+        const Cell home = frame_.cell_of(xi);
+        visits.clear();
+        for (const MaskCell<Dim>& m : mask_) {
+          if (!mask_keeps(m.gap2, reach)) continue;
+          Cell c;
+          for (int k = 0; k < Dim; ++k) c[k] = home[k] + m.offset[k];
+          if (!frame_.inside(c)) continue;  // no particle lives outside the bounding box
+          const std::uint32_t b = bucket(c);
+          __builtin_prefetch(&start_[b]);
+          visits.push_back({c, b, 0});
+        }
+        for (Visit& v : visits) {
+          const std::uint32_t b = v.begin;
+          v.begin = start_[b];
+          v.end = start_[b + 1];
+          __builtin_prefetch(&entries_[v.begin]);
+        }
+        for (const Visit& v : visits) {
+          for (std::uint32_t e = v.begin; e < v.end; ++e) {
+            const Entry& en = entries_[e];
+            if (en.cell != v.cell || en.index == i) continue;  // another cell sharing the bucket
+            ++tests;
+            const Real r2 = distance2(xi, en.x);
+            if (r2 <= hi2) f(i, en.index, r2);
+          }
         }
       }
     }
