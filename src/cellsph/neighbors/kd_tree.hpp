@@ -14,8 +14,8 @@
 #include <span>
 #include <vector>
 
-#include <nanoflann.hpp>
 #include <omp.h>
+#include <nanoflann.hpp>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/vec.hpp"
@@ -125,9 +125,8 @@ class KdTree {
         const Point xi = x[i];
         const Real hi2 = h_[i] * h_[i];
         // Enlarged radius; nextafter keeps it positive when h_i = 0 so duplicates are still found.
-        const Real query =
-            std::nextafter(static_cast<Real>(hi2 * static_cast<Real>(1.0 + kRadiusSlack)),
-                           std::numeric_limits<Real>::infinity());
+        const Real query = std::nextafter(static_cast<Real>(hi2 * static_cast<Real>(1.0 + kRadiusSlack)),
+                                          std::numeric_limits<Real>::infinity());
         detail::KdCollector<Real> collect{query, &found};
         collect.init();
         index_->findNeighbors(collect, xi.c, params);
@@ -142,11 +141,13 @@ class KdTree {
     return tests;
   }
 
-  [[nodiscard]] std::size_t memory_bytes() const { return index_ ? index_->usedMemory(*index_) : 0; }
+  [[nodiscard]] std::size_t memory_bytes() const {
+    return index_ ? index_->usedMemory(*index_) : 0;
+  }
 
  private:
-  using Index = nanoflann::KDTreeSingleIndexAdaptor<detail::CountingL2<Dim, Real>, detail::KdPoints<Dim, Real>,
-                                                    Dim, std::uint32_t>;
+  using Index = nanoflann::KDTreeSingleIndexAdaptor<detail::CountingL2<Dim, Real>,
+                                                    detail::KdPoints<Dim, Real>, Dim, std::uint32_t>;
   std::unique_ptr<detail::KdPoints<Dim, Real>> points_;
   std::unique_ptr<Index> index_;
   std::span<const Real> h_;

@@ -35,19 +35,33 @@ struct MethodParam {
 std::string param_name(const MethodParam& param) {
   std::string name;
   switch (param.method) {
-    case Method::AllPairs: name = "AllPairs"; break;
-    case Method::SpatialHash: name = "SpatialHash"; break;
-    case Method::CellIndex: name = "CellIndex"; break;
-    case Method::SortedGrid: name = "SortedGrid"; break;
-    case Method::KdTree: name = "KdTree"; break;
+    case Method::AllPairs:
+      name = "AllPairs";
+      break;
+    case Method::SpatialHash:
+      name = "SpatialHash";
+      break;
+    case Method::CellIndex:
+      name = "CellIndex";
+      break;
+    case Method::SortedGrid:
+      name = "SortedGrid";
+      break;
+    case Method::KdTree:
+      name = "KdTree";
+      break;
   }
   return name + "_H" + std::to_string(param.subdivision);
 }
 
-std::string param_test_name(const ::testing::TestParamInfo<MethodParam>& info) { return param_name(info.param); }
+std::string param_test_name(const ::testing::TestParamInfo<MethodParam>& info) {
+  return param_name(info.param);
+}
 
 // Readable parameter in failure messages.
-void PrintTo(const MethodParam& p, std::ostream* os) { *os << param_name(p); }
+void PrintTo(const MethodParam& p, std::ostream* os) {
+  *os << param_name(p);
+}
 
 // Every method of kAllMethods; H = 2, 3 only for the methods built on cells.
 std::vector<MethodParam> all_params() {
@@ -312,14 +326,14 @@ TEST_P(CrossMethod, VariableSupport10x) {
 
 // Neighbours placed in the farthest cells of the H-mask: for every gap vector g between the home
 // cell and a mask cell (in cell units) and every direction, particle i sits at the home cell's
-// corner facing that cell (offset g_k + 1 along each axis), j just inside the mask cell's nearest corner, and h_i is set so that
-// (h_i / h')^2 = |g|^2 + 0.02. j is then a neighbour only reachable through that mask cell, and a
-// mask or per-particle cell skip that is too tight by more than 1% loses it.
+// corner facing that cell (offset g_k + 1 along each axis), j just inside the mask cell's nearest corner, and
+// h_i is set so that (h_i / h')^2 = |g|^2 + 0.02. j is then a neighbour only reachable through that mask
+// cell, and a mask or per-particle cell skip that is too tight by more than 1% loses it.
 template <int Dim, class Real>
 void expect_exact_at_mask_edges(const MethodParam& p) {
   const int H = p.subdivision;
   const double cell = 1.0 / H * kCellInflation;  // h' for max h = 1
-  Points<Dim, Real> x(1);                          // x[0] = origin anchors the bounding box
+  Points<Dim, Real> x(1);                        // x[0] = origin anchors the bounding box
   std::vector<Real> h(1, Real(1));
   std::array<int, Dim> g{};
   std::size_t blocks = 0;

@@ -125,7 +125,8 @@ class SortedGrid {
 
   [[nodiscard]] std::uint64_t linear(const Cell& c) const {
     std::uint64_t v = 0;
-    for (int k = 0; k < Dim; ++k) v += static_cast<std::uint64_t>(c[k]) * static_cast<std::uint64_t>(stride_[k]);
+    for (int k = 0; k < Dim; ++k)
+      v += static_cast<std::uint64_t>(c[k]) * static_cast<std::uint64_t>(stride_[k]);
     return v;
   }
 

@@ -34,7 +34,7 @@ struct CellFrame {
 
   std::array<double, Dim> lo{};
   std::array<std::int64_t, Dim> dims{};  // cells per axis covering the bounding box
-  double cell = 1.0;                      // h'
+  double cell = 1.0;                     // h'
   double inv_cell = 1.0;
   double max_h = 0.0;
 
@@ -216,7 +216,9 @@ class SpatialHash {
     return start_.capacity() * sizeof(std::uint32_t) + entries_.capacity() * sizeof(Entry) +
            mask_.capacity() * sizeof(MaskCell<Dim>);
   }
-  [[nodiscard]] std::size_t table_size() const { return table_size_; }
+  [[nodiscard]] std::size_t table_size() const {
+    return table_size_;
+  }
 
  private:
   struct Entry {
