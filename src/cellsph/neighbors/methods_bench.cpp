@@ -5,6 +5,7 @@
 //   build/cellsph_bench --benchmark_filter=Methods
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -55,6 +56,29 @@ void BM_MethodsJitteredLattice1e6(benchmark::State& state) {
   state.counters["memory_MB"] = static_cast<double>(s.memory_bytes) / 1048576.0;
 }
 
+// Build plus one visitor traversal (no list): find_all above traverses twice (count, then fill),
+// so this is the figure to compare with a single radius search per particle.
+void BM_MethodsVisitorJitteredLattice1e6(benchmark::State& state) {
+  const auto method = static_cast<Method>(state.range(0));
+  const int subdivision = static_cast<int>(state.range(1));
+  const auto& x = lattice_1e6();
+  ScopedThreads threads(2);
+  NeighborSearch<3, float> ns({.method = method, .subdivision = subdivision});
+  std::vector<std::uint32_t> counts(x.size());
+  std::uint64_t candidates = 0;
+  for (auto _ : state) {
+    ns.build(x, 2.0F);
+    std::fill(counts.begin(), counts.end(), 0U);
+    candidates = ns.for_each_pair([&counts](std::uint32_t i, std::uint32_t, float) { ++counts[i]; });
+    benchmark::DoNotOptimize(counts.data());
+  }
+  std::uint64_t pairs = 0;
+  for (auto c : counts) pairs += c;
+  state.SetLabel(std::string(method_name(method)) + " H=" + std::to_string(subdivision));
+  state.counters["pairs"] = static_cast<double>(pairs);
+  state.counters["cand_per_nb"] = static_cast<double>(candidates) / static_cast<double>(pairs);
+}
+
 void methods(benchmark::internal::Benchmark* b) {
   b->Args({static_cast<std::int64_t>(Method::SpatialHash), 1});
   b->Args({static_cast<std::int64_t>(Method::SpatialHash), 2});
@@ -70,5 +94,16 @@ BENCHMARK(BM_MethodsJitteredLattice1e6)
     ->UseRealTime()
     ->Iterations(3);
 
+}  // namespace
+}  // namespace cellsph
+
+namespace cellsph {
+namespace {
+BENCHMARK(BM_MethodsVisitorJitteredLattice1e6)
+    ->Apply(methods)
+    ->ArgNames({"method", "H"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 }  // namespace
 }  // namespace cellsph
