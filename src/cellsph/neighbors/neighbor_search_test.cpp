@@ -12,8 +12,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <ostream>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -416,6 +418,27 @@ TEST(SortedGrid, RefusesADenseGridTooLargeForMemory) {
   } catch (const CapacityError& e) {
     EXPECT_NE(std::string(e.what()).find("cells"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("bytes"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace cellsph
+
+namespace cellsph {
+namespace {
+
+// A NaN coordinate or support would silently drop pairs from a grid; the methods refuse it.
+TEST(GridAndTreeMethods, RefuseNonFiniteInput) {
+  for (Method m : {Method::SpatialHash, Method::SortedGrid, Method::KdTree}) {
+    SCOPED_TRACE(std::string(method_name(m)));
+    NeighborSearch<2, float> ns({.method = m});
+    std::vector<Vec<2, float>> x = {{{0.0F, 0.0F}}, {{1.0F, std::nanf("")}}};
+    EXPECT_THROW(ns.build(x, std::vector<float>(2, 1.0F)), std::logic_error);
+    x[1][1] = 1.0F;
+    EXPECT_THROW(ns.build(x, std::vector<float>{1.0F, std::numeric_limits<float>::infinity()}),
+                 std::logic_error);
+    EXPECT_THROW(ns.build(x, std::vector<float>{1.0F, -1.0F}), std::logic_error);
+    EXPECT_NO_THROW(ns.build(x, std::vector<float>(2, 1.0F)));
   }
 }
 
