@@ -1,24 +1,142 @@
 #pragma once
-// PLACEHOLDER: to be replaced by the real implementation of SortedGrid.
+// Sorted uniform grid, as in the CUDA SDK "particles" sample (write-up 003): a dense grid over the
+// bounding box, the cell hash of a particle is its linear cell index, the (hash, index) pairs are
+// sorted by hash, positions are reordered into that order, and cellStart / cellEnd arrays over the
+// whole dense grid give each cell's range of sorted particles. A query scans the H-mask cells
+// around the particle's own cell (3^Dim cells for H = 1).
+//
+// The dense arrays cost 8 bytes per grid cell whether occupied or not; a sparse set in a large box
+// can need far more memory than the particles themselves, so the cell count is capped.
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
-#include <stdexcept>
+#include <sstream>
+#include <vector>
 
+#include "cellsph/core/error.hpp"
 #include "cellsph/core/vec.hpp"
+#include "cellsph/neighbors/hmask.hpp"
 #include "cellsph/neighbors/neighbor_list.hpp"
+#include "cellsph/neighbors/spatial_hash.hpp"  // CellFrame: the grid of eq. 15
 
 namespace cellsph {
 
 template <int Dim, class Real>
 class SortedGrid {
  public:
-  explicit SortedGrid(const SearchOptions& /*opt*/ = {}) {}
-  void build(std::span<const Vec<Dim, Real>>, std::span<const Real>) {
-    throw std::logic_error("SortedGrid is not implemented yet");
+  using Point = Vec<Dim, Real>;
+  using Cell = typename CellFrame<Dim, Real>::Cell;
+
+  // Largest dense grid accepted: 2^27 cells, i.e. 1 GiB of cellStart/cellEnd.
+  static constexpr double kMaxCells = 134217728.0;
+
+  explicit SortedGrid(const SearchOptions& opt = {}) : subdivision_(opt.subdivision) {}
+
+  void build(std::span<const Point> x, std::span<const Real> h) {
+    const std::size_t n = x.size();
+    frame_.build(x, h, subdivision_, "sorted-grid");
+    mask_ = frame_.mask();
+    double cells = 1.0;
+    for (int k = 0; k < Dim; ++k) cells *= static_cast<double>(frame_.dims[k]);
+    if (cells > kMaxCells) {
+      std::ostringstream os;
+      os << "sorted-grid: the dense grid over the bounding box would have " << cells << " cells (";
+      for (int k = 0; k < Dim; ++k) os << (k ? " x " : "") << frame_.dims[k];
+      os << ", cell size " << frame_.cell << ") needing " << cells * 2 * sizeof(std::uint32_t)
+         << " bytes for cellStart/cellEnd; the limit is " << kMaxCells
+         << " cells. Use cell-index or spatial-hash for sparse point sets.";
+      throw CapacityError(os.str());
+    }
+    const auto num_cells = static_cast<std::size_t>(cells);
+    for (int k = 0; k < Dim; ++k) stride_[k] = k == 0 ? 1 : stride_[k - 1] * frame_.dims[k - 1];
+
+    // calcHash: key = (linear cell index << 32) | particle index, so sorting the keys sorts the
+    // (hash, index) pairs by hash with ties in index order: the same order for any thread count.
+    const auto count = static_cast<std::int64_t>(n);
+    std::vector<std::uint64_t> keys(n);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < count; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      keys[u] = (linear(frame_.cell_of(x[u])) << 32) | static_cast<std::uint64_t>(u);
+    }
+    std::sort(keys.begin(), keys.end());
+
+    // reorderDataAndFindCellStart: a cell starts where the hash differs from the previous one.
+    index_.resize(n);
+    xs_.resize(n);
+    hs_.resize(n);
+    cell_start_.assign(num_cells, kEmpty);
+    cell_end_.assign(num_cells, kEmpty);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t p = 0; p < count; ++p) {
+      const auto u = static_cast<std::size_t>(p);
+      const auto i = static_cast<std::uint32_t>(keys[u] & 0xffffffffU);
+      const std::size_t cell = keys[u] >> 32;
+      index_[u] = i;
+      xs_[u] = x[i];
+      hs_[u] = h[i];
+      if (u == 0 || (keys[u - 1] >> 32) != cell) cell_start_[cell] = static_cast<std::uint32_t>(u);
+      if (u + 1 == n || (keys[u + 1] >> 32) != cell) cell_end_[cell] = static_cast<std::uint32_t>(u + 1);
+    }
   }
+
   template <class F>
-  std::uint64_t for_each_pair(F&&) const { return 0; }
-  [[nodiscard]] std::size_t memory_bytes() const { return 0; }
+  std::uint64_t for_each_pair(F&& f) const {
+    const auto count = static_cast<std::int64_t>(index_.size());
+    std::uint64_t tests = 0;
+    // Particles are visited in sorted order: consecutive particles share their neighbour cells.
+#pragma omp parallel for schedule(static) reduction(+ : tests)
+    for (std::int64_t pp = 0; pp < count; ++pp) {
+      const auto p = static_cast<std::uint32_t>(pp);
+      const std::uint32_t i = index_[p];
+      const Point xi = xs_[p];
+      const Real hi2 = hs_[p] * hs_[p];
+      const double reach = frame_.reach(hs_[p]);
+      const Cell home = frame_.cell_of(xi);
+      for (const MaskCell<Dim>& m : mask_) {
+        if (!mask_keeps(m.gap2, reach)) continue;
+        Cell c;
+        for (int k = 0; k < Dim; ++k) c[k] = home[k] + m.offset[k];
+        if (!frame_.inside(c)) continue;
+        const std::size_t lin = linear(c);
+        const std::uint32_t s = cell_start_[lin];
+        if (s == kEmpty) continue;
+        for (std::uint32_t q = s, e = cell_end_[lin]; q < e; ++q) {
+          if (q == p) continue;
+          ++tests;
+          const Real r2 = distance2(xi, xs_[q]);
+          if (r2 <= hi2) f(i, index_[q], r2);
+        }
+      }
+    }
+    return tests;
+  }
+
+  [[nodiscard]] std::size_t memory_bytes() const {
+    return (cell_start_.capacity() + cell_end_.capacity() + index_.capacity()) * sizeof(std::uint32_t) +
+           xs_.capacity() * sizeof(Point) + hs_.capacity() * sizeof(Real) +
+           mask_.capacity() * sizeof(MaskCell<Dim>);
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
+
+  [[nodiscard]] std::uint64_t linear(const Cell& c) const {
+    std::uint64_t v = 0;
+    for (int k = 0; k < Dim; ++k)
+      v += static_cast<std::uint64_t>(c[k]) * static_cast<std::uint64_t>(stride_[k]);
+    return v;
+  }
+
+  int subdivision_;
+  CellFrame<Dim, Real> frame_;
+  std::array<std::int64_t, Dim> stride_{};
+  std::vector<MaskCell<Dim>> mask_;
+  std::vector<std::uint32_t> cell_start_, cell_end_, index_;
+  std::vector<Point> xs_;
+  std::vector<Real> hs_;
 };
 
 }  // namespace cellsph
