@@ -6,6 +6,8 @@
 // defined only for the test target, so the program sees an empty file here.
 #ifdef CELLSPH_BINARY
 #include <gtest/gtest.h>
+
+#include "cli_test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,77 +23,13 @@
 
 namespace {
 
+using cellsph::test::q;
+using cellsph::test::read_file;
+using cellsph::test::run_cli;
+using cellsph::test::RunResult;
+using cellsph::test::TempDir;
+using cellsph::test::write_file;
 namespace fs = std::filesystem;
-
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("cellsph_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  [[nodiscard]] fs::path operator/(const std::string& name) const { return path_ / name; }
-  [[nodiscard]] const fs::path& path() const { return path_; }
-  // Names of the files in the directory, sorted (to spot stray temporary files).
-  [[nodiscard]] std::vector<std::string> listing() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
-
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream f(p, std::ios::binary);
-  f << text;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-struct RunResult {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-// Runs the built cellsph with `args` (already shell-quoted where needed).
-RunResult run_cli(const TempDir& dir, const std::string& args) {
-  const fs::path out = dir.path() / "..stdout", err = dir.path() / "..stderr";
-  const std::string cmd =
-      std::string("'") + CELLSPH_BINARY + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_file(out);
-  r.err = read_file(err);
-  fs::remove(out);
-  fs::remove(err);
-  return r;
-}
-
-// Shell-quoted path (GCC 12 warns falsely, -Wrestrict, on "literal" + std::string temporaries).
-std::string q(const fs::path& p) {
-  std::string s = "'";
-  s += p.string();
-  s += '\'';
-  return s;
-}
 
 // Exact decimal text of a double, so the program reads back the very value the reference used.
 std::string num(double v) {

@@ -1,0 +1,190 @@
+// `cellsph run` and `cellsph scenes` on the built program: outputs and their index, resume bit for
+// bit, error exits (2 for bad input, 3 for an unstable run), help and listing.
+// GCC 12 reports a false -Wrestrict on chains of std::string operator+ at -O3 (GCC bug 105329).
+#pragma GCC diagnostic ignored "-Wrestrict"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "cli_test_util.hpp"
+
+namespace {
+
+using cellsph::test::q;
+using cellsph::test::read_file;
+using cellsph::test::run_cli;
+using cellsph::test::TempDir;
+using cellsph::test::write_file;
+namespace fs = std::filesystem;
+
+// 72 particles falling in a box: a run of 0.1 s takes a fraction of a second.
+const char* kTiny = R"({
+  "name": "tiny", "description": "test", "dimension": 2, "spacing": 0.05,
+  "phases": [{"name": "water", "rest_density": 1000, "viscosity": 0.5}],
+  "solver": {"model": "wcsph", "support": 0.1, "density_kernel": "cubic", "pressure_kernel": "cubic",
+             "eos": {"kind": "tait", "stiffness": 20000, "gamma": 7, "clamp_negative": true}},
+  "time": {"end": 0.1, "stepping": "courant", "dt_max": 0.002},
+  "neighbors": {"method": "sorted-grid"},
+  "fluids": [{"min": [0, 0], "max": [0.3, 0.6]}],
+  "boundary": {"box": {"min": [0, 0], "max": [1, 1]}},
+  "output": {"fps": 50, "formats": ["vtu", "ply", "csv"], "checkpoint_every": 1}
+})";
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text) {
+    if (c == '\n') {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out(1);
+  for (char c : s) {
+    if (c == sep)
+      out.emplace_back();
+    else
+      out.back() += c;
+  }
+  return out;
+}
+
+TEST(CliRun, WritesEveryFormatTheIndexAndTheCollection) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  const auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "out") + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto idx = lines(read_file(dir / "out" / "frames.csv"));
+  ASSERT_FALSE(idx.empty());
+  EXPECT_EQ(idx[0], "frame,time,vtu,ply,csv");
+  ASSERT_EQ(idx.size(), 1u + 6u) << "frames at t = 0, 0.02, ..., 0.1";
+  double last_time = -1;
+  for (std::size_t k = 1; k < idx.size(); ++k) {
+    const auto cols = split(idx[k], ',');
+    ASSERT_EQ(cols.size(), 5u) << idx[k];
+    EXPECT_EQ(std::stoul(cols[0]), k - 1);
+    const double t = std::stod(cols[1]);
+    EXPECT_GT(t, last_time);
+    EXPECT_NEAR(t, 0.02 * double(k - 1), 0.0021) << "frame times follow --fps within one step";
+    last_time = t;
+    for (std::size_t c = 2; c < 5; ++c) EXPECT_TRUE(fs::exists(dir / "out" / cols[c])) << cols[c];
+  }
+  EXPECT_TRUE(fs::exists(dir / "out" / "particles.pvd"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "checkpoint.bin"));
+  const auto csv = lines(read_file(dir / "out" / "frame_00005.csv"));
+  ASSERT_EQ(csv.size(), 1u + 72u);
+  EXPECT_EQ(csv[0].rfind("x,y,vx,vy,density,pressure,phase", 0), 0u) << csv[0];
+  for (const auto& e : fs::directory_iterator(dir / "out"))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "left behind: " << e.path();
+}
+
+TEST(CliRun, ResumeContinuesBitForBit) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "whole") + " --quiet --format csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Stop half-way, then resume to the same end.
+  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "parts") + " --quiet --format csv --until 0.05");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_FALSE(fs::exists(dir / "parts" / "frame_00005.csv"));
+  r = run_cli(dir, "run --resume " + q(dir / "parts") + " --until 0.1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int f = 0; f <= 5; ++f) {
+    const std::string name = "frame_0000" + std::to_string(f) + ".csv";
+    const std::string a = read_file(dir / "whole" / name), b = read_file(dir / "parts" / name);
+    ASSERT_FALSE(a.empty()) << name;
+    EXPECT_TRUE(a == b) << name << " differs after resume";
+  }
+  EXPECT_EQ(read_file(dir / "whole" / "frames.csv"), read_file(dir / "parts" / "frames.csv"));
+}
+
+TEST(CliRun, SameResultWithEveryNeighbourMethod) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  std::string reference;
+  for (const char* m : {"all-pairs", "spatial-hash", "cell-index", "sorted-grid", "kd-tree"}) {
+    const auto out = dir / m;
+    const auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(out) + " --quiet --format csv --method " + m);
+    ASSERT_EQ(r.code, 0) << m << ": " << r.err;
+    const std::string last = read_file(out / "frame_00005.csv");
+    ASSERT_FALSE(last.empty());
+    if (reference.empty())
+      reference = last;
+    else
+      EXPECT_TRUE(last == reference) << m << " gives different physics from all-pairs";
+  }
+}
+
+TEST(CliRun, BadSceneExitsWithCode2NamingFileAndKey) {
+  TempDir dir;
+  std::string bad = kTiny;
+  bad.replace(bad.find("\"spacing\""), 9, "\"spacng\": 1, \"spacing\"");
+  write_file(dir / "bad.json", bad);
+  const auto r = run_cli(dir, "run " + q(dir / "bad.json") + " --out " + q(dir / "out"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/spacng"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "frames.csv"));
+
+  const auto r2 = run_cli(dir, "run no-such-scene");
+  EXPECT_EQ(r2.code, 2);
+  EXPECT_NE(r2.err.find("no-such-scene"), std::string::npos) << r2.err;
+  EXPECT_NE(r2.err.find("dam-break-2d"), std::string::npos) << "lists the built-in scenes: " << r2.err;
+
+  const auto r3 = run_cli(dir, "run " + q(dir / "bad.json") + " --method octree");
+  EXPECT_EQ(r3.code, 2);
+}
+
+TEST(CliRun, UnstableRunStopsWithDiagnosisAndCode3) {
+  TempDir dir;
+  std::string s = kTiny;
+  // Gravity a million times too strong and no walls: particles leave the domain within a few steps.
+  s.replace(s.find("\"eos\""), 5, "\"gravity\": [0, -1e7], \"eos\"");
+  s.replace(s.find("\"boundary\""), 10, "\"domain\"");
+  s.replace(s.find("{\"box\": "), 8, "");
+  s.replace(s.find("}},\n  \"output\""), 2, "}");
+  write_file(dir / "unstable.json", s);
+  const auto r = run_cli(dir, "run " + q(dir / "unstable.json") + " --out " + q(dir / "out") + " --quiet");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("step"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("particle"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "out" / "frame_00000.vtu")) << "frames written before the blow-up stay";
+}
+
+TEST(CliRun, RenderWritesOnePngPerFrame) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  const auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "out") +
+                                  " --quiet --format vtu --render --until 0.04 --color-by pressure");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int f = 0; f <= 2; ++f)
+    EXPECT_TRUE(fs::exists(dir / "out" / "png" / ("frame_0000" + std::to_string(f) + ".png"))) << f;
+}
+
+TEST(CliRun, HelpDocumentsEveryOption) {
+  TempDir dir;
+  const auto r = run_cli(dir, "run --help");
+  EXPECT_EQ(r.code, 0);
+  for (const char* opt : {"--out", "--threads", "--method", "--until", "--steps", "--fps", "--format", "--render",
+                          "--color-by", "--quiet", "--resume", "default"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt << " missing from --help:\n" << r.out;
+}
+
+TEST(CliRun, ScenesListsEveryBuiltinScene) {
+  TempDir dir;
+  const auto r = run_cli(dir, "scenes");
+  EXPECT_EQ(r.code, 0);
+  for (const auto& e : fs::directory_iterator(fs::path(CELLSPH_SOURCE_DIR) / "scenes"))
+    EXPECT_NE(r.out.find(e.path().stem().string()), std::string::npos) << e.path();
+}
+
+}  // namespace
