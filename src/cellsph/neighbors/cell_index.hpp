@@ -22,9 +22,13 @@
 #include <limits>
 #include <span>
 #include <sstream>
+#include <type_traits>
 #include <vector>
 
 #include <omp.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
@@ -121,13 +125,7 @@ class CellIndex {
       const std::uint32_t i = ids_[p];
       Real xi[Dim];
       for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-      const Real hi2 = hs_[p] * hs_[p];
-      for (int s = 0; s < nr; ++s)
-        for (std::uint32_t q = r[s].begin; q < r[s].end; ++q) {
-          if (q == p) continue;
-          const Real r2 = dist2(xi, q);
-          if (r2 <= hi2) f(i, ids_[q], r2);
-        }
+      for_each_hit(p, r, nr, [&](std::uint32_t q) { f(i, ids_[q], dist2(xi, q)); });
     });
   }
 
@@ -144,8 +142,10 @@ class CellIndex {
       Real xi[Dim];
       for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
       const Real hi2 = hs_[p] * hs_[p];
-      std::uint32_t c = 0;
-      for (int s = 0; s < nr; ++s) c += count_in(xi, hi2, r[s].begin, r[s].end);
+      std::uint64_t c = 0;
+      for (int s = 0; s < nr; ++s)
+        for (std::uint32_t b = r[s].begin; b < r[s].end; b += 64)
+          c += popcount64(hits64(xi, hi2, b, std::min<std::uint32_t>(64, r[s].end - b)));
       // p itself lies in its own home cell at distance 0 <= h^2 and was counted once.
       counts[ids_[p]] = c - 1;
     });
@@ -162,20 +162,20 @@ class CellIndex {
       const std::uint32_t i = ids_[p];
       std::uint32_t* row = idx + off[i];
       const std::uint64_t len = off[i + 1] - off[i];
-      Real xi[Dim];
-      for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-      const Real hi2 = hs_[p] * hs_[p];
+      // Typical rows are gathered in a small buffer and placed by rank; long ones go to std::sort.
+      std::uint32_t buf[kRankSortMax + 4];
+      std::uint32_t* dst = len <= kRankSortMax ? buf : row;
       std::uint64_t c = 0;
-      for (int s = 0; s < nr; ++s)
-        for (std::uint32_t q = r[s].begin; q < r[s].end; ++q) {
-          if (dist2(xi, q) <= hi2 && q != p) {
-            CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
-            row[c++] = ids_[q];
-          }
-        }
+      for_each_hit(p, r, nr, [&](std::uint32_t q) {
+        CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
+        dst[c++] = ids_[q];
+      });
       CELLSPH_CHECK(c == len,
                     "cell-index: fill pass found " << c << " neighbours of " << i << ", counted " << len);
-      sort_row(row, row + len);
+      if (dst == buf)
+        rank_sort(buf, static_cast<std::uint32_t>(len), row);
+      else
+        std::sort(row, row + len);
     });
     return candidates;
   }
@@ -325,7 +325,8 @@ class CellIndex {
   // Positions and support lengths copied into key order: a cell's particles, and the cells along
   // axis 0, are then contiguous in memory.
   void gather(std::span<const Point> x, std::span<const Real> h) {
-    for (auto& v : xs_) v.resize(n_);
+    // kPad spare entries: hits64 loads whole vectors past the end of a range.
+    for (auto& v : xs_) v.assign(n_ + kPad, Real(0));
     hs_.resize(n_);
     parallel_for(n_, [&](std::size_t p) {
       const std::uint32_t i = ids_[p];
@@ -345,23 +346,106 @@ class CellIndex {
     return s;
   }
 
-  std::uint32_t count_in(const Real* xi, Real hi2, std::uint32_t b, std::uint32_t e) const {
-    const Real* __restrict x0 = xs_[0].data();
-    const Real* __restrict x1 = xs_[1].data();
-    const Real* __restrict x2 = xs_[Dim - 1].data();
-    std::uint32_t c = 0;
-    for (std::uint32_t q = b; q < e; ++q) {
-      const Real d0 = xi[0] - x0[q];
-      const Real d1 = xi[1] - x1[q];
-      Real s = d0 * d0;
-      s += d1 * d1;
-      if constexpr (Dim == 3) {
-        const Real d2 = xi[2] - x2[q];
-        s += d2 * d2;
+  static std::uint64_t popcount64(std::uint64_t v) {
+    // SWAR popcount: portable and branch free without -mpopcnt (std::popcount becomes a libgcc call).
+    v = v - ((v >> 1) & 0x5555555555555555ull);
+    v = (v & 0x3333333333333333ull) + ((v >> 2) & 0x3333333333333333ull);
+    v = (v + (v >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return (v * 0x0101010101010101ull) >> 56;
+  }
+
+  // Sorts the distinct values in[0, L) into out by rank: out[#{m : in[m] < in[k]}] = in[k]. No
+  // data-dependent branches, unlike insertion sort on rows that arrive in cell order. in must have
+  // room for 4 entries past L (overwritten).
+  static void rank_sort(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) {
+    for (std::uint32_t t = L; t < L + 4; ++t) in[t] = std::numeric_limits<std::uint32_t>::max();
+#if defined(__SSE2__)
+    const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));  // unsigned order via signed compare
+    for (std::uint32_t k = 0; k < L; ++k) {
+      const __m128i v = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(in[k])), bias);
+      __m128i acc = _mm_setzero_si128();
+      for (std::uint32_t m = 0; m < L; m += 4) {
+        const __m128i w = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + m)), bias);
+        acc = _mm_sub_epi32(acc, _mm_cmplt_epi32(w, v));
       }
-      c += s <= hi2 ? 1u : 0u;
+      acc = _mm_add_epi32(acc, _mm_shuffle_epi32(acc, 0x4E));
+      acc = _mm_add_epi32(acc, _mm_shuffle_epi32(acc, 0xB1));
+      out[_mm_cvtsi128_si32(acc)] = in[k];
     }
-    return c;
+#else
+    for (std::uint32_t k = 0; k < L; ++k) {
+      std::uint32_t rank = 0;
+      for (std::uint32_t m = 0; m < L; ++m) rank += in[m] < in[k] ? 1u : 0u;
+      out[rank] = in[k];
+    }
+#endif
+  }
+
+  // Calls g(q) for every candidate q != p in the ranges with distance2(x_p, x_q) <= h_p^2.
+  template <class G>
+  void for_each_hit(std::uint32_t p, const Range* r, int nr, G&& g) const {
+    Real xi[Dim];
+    for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
+    const Real hi2 = hs_[p] * hs_[p];
+    for (int s = 0; s < nr; ++s)
+      for (std::uint32_t b = r[s].begin; b < r[s].end; b += 64) {
+        // About 1 candidate in 7 is a neighbour: iterating the set bits of a hit mask costs one
+        // step per neighbour and no branch per candidate.
+        std::uint64_t bits = hits64(xi, hi2, b, std::min<std::uint32_t>(64, r[s].end - b));
+        while (bits != 0) {
+          const std::uint32_t q = b + static_cast<std::uint32_t>(std::countr_zero(bits));
+          bits &= bits - 1;
+          if (q != p) g(q);
+        }
+      }
+  }
+
+  // Bit t set when distance2(xi, x_{b+t}) <= hi2, for t < m <= 64. Computed four floats (two
+  // doubles) at a time with the same operations in the same order as distance2, so the test is
+  // bit-identical to the all-pairs reference. Reads up to kPad entries past b + m (padding).
+  std::uint64_t hits64(const Real* xi, Real hi2, std::uint32_t b, std::uint32_t m) const {
+    std::uint64_t bits = 0;
+#if defined(__SSE2__)
+    if constexpr (std::is_same_v<Real, float>) {
+      const __m128 h2 = _mm_set1_ps(hi2);
+      __m128 c[Dim];
+      const float* ax[Dim];
+      for (int k = 0; k < Dim; ++k) {
+        c[k] = _mm_set1_ps(xi[k]);
+        ax[k] = xs_[k].data() + b;
+      }
+      for (std::uint32_t t = 0; t < m; t += 4) {
+        __m128 d = _mm_sub_ps(c[0], _mm_loadu_ps(ax[0] + t));
+        __m128 s2 = _mm_mul_ps(d, d);
+        for (int k = 1; k < Dim; ++k) {
+          d = _mm_sub_ps(c[k], _mm_loadu_ps(ax[k] + t));
+          s2 = _mm_add_ps(s2, _mm_mul_ps(d, d));
+        }
+        bits |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, h2))) << t;
+      }
+    } else if constexpr (std::is_same_v<Real, double>) {
+      const __m128d h2 = _mm_set1_pd(hi2);
+      __m128d c[Dim];
+      const double* ax[Dim];
+      for (int k = 0; k < Dim; ++k) {
+        c[k] = _mm_set1_pd(xi[k]);
+        ax[k] = xs_[k].data() + b;
+      }
+      for (std::uint32_t t = 0; t < m; t += 2) {
+        __m128d d = _mm_sub_pd(c[0], _mm_loadu_pd(ax[0] + t));
+        __m128d s2 = _mm_mul_pd(d, d);
+        for (int k = 1; k < Dim; ++k) {
+          d = _mm_sub_pd(c[k], _mm_loadu_pd(ax[k] + t));
+          s2 = _mm_add_pd(s2, _mm_mul_pd(d, d));
+        }
+        bits |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmple_pd(s2, h2))) << t;
+      }
+    } else
+#endif
+    {
+      for (std::uint32_t t = 0; t < m; ++t) bits |= static_cast<std::uint64_t>(dist2(xi, b + t) <= hi2) << t;
+    }
+    return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
   }
 
   // The streaming traversal of section 4.2. The sorted cells are split into chunks with
@@ -439,6 +523,9 @@ class CellIndex {
     }
     return k;
   }
+
+  static constexpr std::size_t kPad = 4;
+  static constexpr std::uint32_t kRankSortMax = 96;
 
   int subdivision_ = 1;
   bool force_wide_ = false;
