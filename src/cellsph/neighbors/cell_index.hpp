@@ -29,6 +29,10 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(CELLSPH_NO_AVX2)
+#include <immintrin.h>
+#define CELLSPH_CELL_INDEX_AVX2 1
+#endif
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
@@ -39,6 +43,69 @@
 #include "cellsph/neighbors/radix_sort.hpp"
 
 namespace cellsph {
+
+namespace detail {
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+// AVX2 versions of CellIndex's two inner loops, chosen at run time when the CPU has AVX2 (the
+// build targets baseline x86-64). Same operations in the same order as the scalar and SSE2 code
+// (no FMA), so every result is identical whichever path runs.
+inline bool cpu_has_avx2() {
+  return __builtin_cpu_supports("avx2");
+}
+
+template <int Dim, class Real>
+__attribute__((target("avx2"))) std::uint64_t hits64_avx2(const Real* const* ax, const Real* xi, Real hi2,
+                                                          std::uint32_t m) {
+  std::uint64_t bits = 0;
+  if constexpr (std::is_same_v<Real, float>) {
+    const __m256 h2 = _mm256_set1_ps(hi2);
+    for (std::uint32_t t = 0; t < m; t += 8) {
+      __m256 d = _mm256_sub_ps(_mm256_set1_ps(xi[0]), _mm256_loadu_ps(ax[0] + t));
+      __m256 s2 = _mm256_mul_ps(d, d);
+      for (int k = 1; k < Dim; ++k) {
+        d = _mm256_sub_ps(_mm256_set1_ps(xi[k]), _mm256_loadu_ps(ax[k] + t));
+        s2 = _mm256_add_ps(s2, _mm256_mul_ps(d, d));
+      }
+      bits |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, h2, _CMP_LE_OQ))) << t;
+    }
+  } else {
+    const __m256d h2 = _mm256_set1_pd(hi2);
+    for (std::uint32_t t = 0; t < m; t += 4) {
+      __m256d d = _mm256_sub_pd(_mm256_set1_pd(xi[0]), _mm256_loadu_pd(ax[0] + t));
+      __m256d s2 = _mm256_mul_pd(d, d);
+      for (int k = 1; k < Dim; ++k) {
+        d = _mm256_sub_pd(_mm256_set1_pd(xi[k]), _mm256_loadu_pd(ax[k] + t));
+        s2 = _mm256_add_pd(s2, _mm256_mul_pd(d, d));
+      }
+      bits |= static_cast<std::uint64_t>(_mm256_movemask_pd(_mm256_cmp_pd(s2, h2, _CMP_LE_OQ))) << t;
+    }
+  }
+  return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
+}
+
+// in[0, L) distinct, with 8 entries of UINT32_MAX after them.
+__attribute__((target("avx2"))) inline void rank_sort_avx2(const std::uint32_t* in, std::uint32_t L,
+                                                           std::uint32_t* out) {
+  const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
+  for (std::uint32_t k = 0; k < L; ++k) {
+    const __m256i v = _mm256_xor_si256(_mm256_set1_epi32(static_cast<int>(in[k])), bias);
+    __m256i acc = _mm256_setzero_si256();
+    for (std::uint32_t m = 0; m < L; m += 8) {
+      const __m256i w = _mm256_xor_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + m)), bias);
+      acc = _mm256_sub_epi32(acc, _mm256_cmpgt_epi32(v, w));
+    }
+    __m128i a = _mm_add_epi32(_mm256_castsi256_si128(acc), _mm256_extracti128_si256(acc, 1));
+    a = _mm_add_epi32(a, _mm_shuffle_epi32(a, 0x4E));
+    a = _mm_add_epi32(a, _mm_shuffle_epi32(a, 0xB1));
+    out[_mm_cvtsi128_si32(a)] = in[k];
+  }
+}
+#else
+inline bool cpu_has_avx2() {
+  return false;
+}
+#endif
+}  // namespace detail
 
 template <int Dim, class Real>
 class CellIndex {
@@ -121,11 +188,11 @@ class CellIndex {
   // thread, consecutively, j in key order. Returns the number of distance tests.
   template <class F>
   std::uint64_t for_each_pair(F&& f) const {
-    return traverse([&](std::uint32_t p, const Range* r, int nr) {
+    return traverse([&](std::uint32_t p, const Block& blk) {
       const std::uint32_t i = ids_[p];
       Real xi[Dim];
       for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-      for_each_hit(p, r, nr, [&](std::uint32_t q) { f(i, ids_[q], dist2(xi, q)); });
+      for_each_hit(p, blk, [&](std::uint32_t q) { f(i, ids_[q], dist2(xi, q)); });
     });
   }
 
@@ -138,15 +205,14 @@ class CellIndex {
       return 0;
     }
     std::uint64_t* counts = out.offsets.data() + 1;
-    const std::uint64_t candidates = traverse([&](std::uint32_t p, const Range* r, int nr) {
+    const std::uint64_t candidates = traverse([&](std::uint32_t p, const Block& blk) {
       Real xi[Dim];
       for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
       const Real hi2 = hs_[p] * hs_[p];
       std::uint64_t c = 0;
-      for (int s = 0; s < nr; ++s)
-        for (std::uint32_t b = r[s].begin; b < r[s].end; b += 64)
-          c += popcount64(hits64(xi, hi2, b, std::min<std::uint32_t>(64, r[s].end - b)));
-      // p itself lies in its own home cell at distance 0 <= h^2 and was counted once.
+      for (std::uint32_t b = 0; b < blk.n; b += 64)
+        c += popcount64(hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b)));
+      // p itself is among its candidates at distance 0 <= h^2 and was counted once.
       counts[ids_[p]] = c - 1;
     });
     for (std::size_t i = 0; i < n_; ++i) out.offsets[i + 1] += out.offsets[i];
@@ -158,15 +224,15 @@ class CellIndex {
     out.indices.resize(total);
     std::uint32_t* idx = out.indices.data();
     const std::uint64_t* off = out.offsets.data();
-    traverse([&](std::uint32_t p, const Range* r, int nr) {
+    traverse([&](std::uint32_t p, const Block& blk) {
       const std::uint32_t i = ids_[p];
       std::uint32_t* row = idx + off[i];
       const std::uint64_t len = off[i + 1] - off[i];
       // Typical rows are gathered in a small buffer and placed by rank; long ones go to std::sort.
-      std::uint32_t buf[kRankSortMax + 4];
+      std::uint32_t buf[kRankSortMax + 8];
       std::uint32_t* dst = len <= kRankSortMax ? buf : row;
       std::uint64_t c = 0;
-      for_each_hit(p, r, nr, [&](std::uint32_t q) {
+      for_each_hit(p, blk, [&](std::uint32_t q) {
         CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
         dst[c++] = ids_[q];
       });
@@ -325,7 +391,7 @@ class CellIndex {
   // Positions and support lengths copied into key order: a cell's particles, and the cells along
   // axis 0, are then contiguous in memory.
   void gather(std::span<const Point> x, std::span<const Real> h) {
-    // kPad spare entries: hits64 loads whole vectors past the end of a range.
+    // kPad spare entries: BlockBuffer copies whole groups of kPad past the end of a range.
     for (auto& v : xs_) v.assign(n_ + kPad, Real(0));
     hs_.resize(n_);
     parallel_for(n_, [&](std::size_t p) {
@@ -356,9 +422,15 @@ class CellIndex {
 
   // Sorts the distinct values in[0, L) into out by rank: out[#{m : in[m] < in[k]}] = in[k]. No
   // data-dependent branches, unlike insertion sort on rows that arrive in cell order. in must have
-  // room for 4 entries past L (overwritten).
-  static void rank_sort(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) {
-    for (std::uint32_t t = L; t < L + 4; ++t) in[t] = std::numeric_limits<std::uint32_t>::max();
+  // room for 8 entries past L (overwritten).
+  void rank_sort(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) const {
+    for (std::uint32_t t = L; t < L + 8; ++t) in[t] = std::numeric_limits<std::uint32_t>::max();
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+    if (avx2_) {
+      detail::rank_sort_avx2(in, L, out);
+      return;
+    }
+#endif
 #if defined(__SSE2__)
     const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));  // unsigned order via signed compare
     for (std::uint32_t k = 0; k < L; ++k) {
@@ -381,61 +453,93 @@ class CellIndex {
 #endif
   }
 
-  // Calls g(q) for every candidate q != p in the ranges with distance2(x_p, x_q) <= h_p^2.
+  // A particle's candidates copied side by side (positions and key-order index q), so that the
+  // distance loop runs over one contiguous block instead of a few short ranges; padded by kPad.
+  struct Block {
+    const Real* x[Dim];
+    const std::uint32_t* q;
+    std::uint32_t n;
+  };
+
+  struct BlockBuffer {
+    std::array<std::vector<Real>, Dim> x;
+    std::vector<std::uint32_t> q;
+
+    // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
+    Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total) {
+      if (q.size() < total + kPad) {
+        for (auto& v : x) v.resize(total + kPad, Real(0));
+        q.resize(total + kPad, 0);
+      }
+      std::uint32_t o = 0;
+      for (int s = 0; s < nr; ++s) {
+        const std::uint32_t b = r[s].begin, len = r[s].end - r[s].begin;
+        // Whole groups of kPad: fixed-size copies the compiler inlines (ranges are ~10-30 long,
+        // too short for a memmove call to pay); the overshoot lands in padding.
+        for (int k = 0; k < Dim; ++k) {
+          const Real* src = ci.xs_[k].data() + b;
+          Real* dst = x[k].data() + o;
+          for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(Real));
+        }
+        for (std::uint32_t t = 0; t < len; ++t) q[o + t] = b + t;
+        o += len;
+      }
+      Block blk{};
+      for (int k = 0; k < Dim; ++k) blk.x[k] = x[k].data();
+      blk.q = q.data();
+      blk.n = total;
+      return blk;
+    }
+  };
+
+  // Calls g(q) for every candidate q != p of the block with distance2(x_p, x_q) <= h_p^2.
   template <class G>
-  void for_each_hit(std::uint32_t p, const Range* r, int nr, G&& g) const {
+  void for_each_hit(std::uint32_t p, const Block& blk, G&& g) const {
     Real xi[Dim];
     for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
     const Real hi2 = hs_[p] * hs_[p];
-    for (int s = 0; s < nr; ++s)
-      for (std::uint32_t b = r[s].begin; b < r[s].end; b += 64) {
-        // About 1 candidate in 7 is a neighbour: iterating the set bits of a hit mask costs one
-        // step per neighbour and no branch per candidate.
-        std::uint64_t bits = hits64(xi, hi2, b, std::min<std::uint32_t>(64, r[s].end - b));
-        while (bits != 0) {
-          const std::uint32_t q = b + static_cast<std::uint32_t>(std::countr_zero(bits));
-          bits &= bits - 1;
-          if (q != p) g(q);
-        }
+    for (std::uint32_t b = 0; b < blk.n; b += 64) {
+      // About 1 candidate in 7 is a neighbour: iterating the set bits of a hit mask costs one
+      // step per neighbour and no branch per candidate.
+      std::uint64_t bits = hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b));
+      while (bits != 0) {
+        const std::uint32_t q = blk.q[b + static_cast<std::uint32_t>(std::countr_zero(bits))];
+        bits &= bits - 1;
+        if (q != p) g(q);
       }
+    }
   }
 
-  // Bit t set when distance2(xi, x_{b+t}) <= hi2, for t < m <= 64. Computed four floats (two
-  // doubles) at a time with the same operations in the same order as distance2, so the test is
-  // bit-identical to the all-pairs reference. Reads up to kPad entries past b + m (padding).
-  std::uint64_t hits64(const Real* xi, Real hi2, std::uint32_t b, std::uint32_t m) const {
+  // Bit t set when distance2(xi, x_{b+t}) <= hi2 for the block's candidates b + t, t < m <= 64.
+  // Computed 8 floats (AVX2) or 4 (SSE2) at a time with the same operations in the same order as
+  // distance2, so the test is bit-identical to the all-pairs reference. Reads up to kPad entries
+  // past b + m (padding).
+  std::uint64_t hits64(const Block& blk, const Real* xi, Real hi2, std::uint32_t b, std::uint32_t m) const {
+    const Real* ax[Dim];
+    for (int k = 0; k < Dim; ++k) ax[k] = blk.x[k] + b;
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+    if (avx2_) return detail::hits64_avx2<Dim, Real>(ax, xi, hi2, m);
+#endif
     std::uint64_t bits = 0;
 #if defined(__SSE2__)
     if constexpr (std::is_same_v<Real, float>) {
       const __m128 h2 = _mm_set1_ps(hi2);
-      __m128 c[Dim];
-      const float* ax[Dim];
-      for (int k = 0; k < Dim; ++k) {
-        c[k] = _mm_set1_ps(xi[k]);
-        ax[k] = xs_[k].data() + b;
-      }
       for (std::uint32_t t = 0; t < m; t += 4) {
-        __m128 d = _mm_sub_ps(c[0], _mm_loadu_ps(ax[0] + t));
+        __m128 d = _mm_sub_ps(_mm_set1_ps(xi[0]), _mm_loadu_ps(ax[0] + t));
         __m128 s2 = _mm_mul_ps(d, d);
         for (int k = 1; k < Dim; ++k) {
-          d = _mm_sub_ps(c[k], _mm_loadu_ps(ax[k] + t));
+          d = _mm_sub_ps(_mm_set1_ps(xi[k]), _mm_loadu_ps(ax[k] + t));
           s2 = _mm_add_ps(s2, _mm_mul_ps(d, d));
         }
         bits |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, h2))) << t;
       }
     } else if constexpr (std::is_same_v<Real, double>) {
       const __m128d h2 = _mm_set1_pd(hi2);
-      __m128d c[Dim];
-      const double* ax[Dim];
-      for (int k = 0; k < Dim; ++k) {
-        c[k] = _mm_set1_pd(xi[k]);
-        ax[k] = xs_[k].data() + b;
-      }
       for (std::uint32_t t = 0; t < m; t += 2) {
-        __m128d d = _mm_sub_pd(c[0], _mm_loadu_pd(ax[0] + t));
+        __m128d d = _mm_sub_pd(_mm_set1_pd(xi[0]), _mm_loadu_pd(ax[0] + t));
         __m128d s2 = _mm_mul_pd(d, d);
         for (int k = 1; k < Dim; ++k) {
-          d = _mm_sub_pd(c[k], _mm_loadu_pd(ax[k] + t));
+          d = _mm_sub_pd(_mm_set1_pd(xi[k]), _mm_loadu_pd(ax[k] + t));
           s2 = _mm_add_pd(s2, _mm_mul_pd(d, d));
         }
         bits |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmple_pd(s2, h2))) << t;
@@ -443,15 +547,23 @@ class CellIndex {
     } else
 #endif
     {
-      for (std::uint32_t t = 0; t < m; ++t) bits |= static_cast<std::uint64_t>(dist2(xi, b + t) <= hi2) << t;
+      for (std::uint32_t t = 0; t < m; ++t) {
+        Real d = xi[0] - ax[0][t];
+        Real s2 = d * d;
+        for (int k = 1; k < Dim; ++k) {
+          d = xi[k] - ax[k][t];
+          s2 += d * d;
+        }
+        bits |= static_cast<std::uint64_t>(s2 <= hi2) << t;
+      }
     }
     return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
   }
 
   // The streaming traversal of section 4.2. The sorted cells are split into chunks with
   // boundaries that depend only on the data; each chunk places its cursors by binary search at its
-  // first cell, then moves them forward only. kernel(p, ranges, count) is called once per particle
-  // p (key order) with the candidate ranges its own support needs. Returns the distance tests.
+  // first cell, then moves them forward only. kernel(p, block) is called once per particle p (key
+  // order) with the candidates its own support needs. Returns the distance tests.
   template <class Kernel>
   std::uint64_t traverse(Kernel&& kernel) const {
     const std::size_t nc = cell_count();
@@ -465,6 +577,7 @@ class CellIndex {
     parallel_chunks(nc, grain, [&](std::size_t u0, std::size_t u1) {
       std::vector<std::uint32_t> cur(M);
       std::vector<Range> found(M), merged(M), mine(M);
+      BlockBuffer home_buf, own_buf;
       for (std::size_t m = 0; m < M; ++m)
         cur[m] =
             static_cast<std::uint32_t>(std::lower_bound(cells, cells + nc, cells[u0] + deltas_[m]) - cells);
@@ -485,10 +598,15 @@ class CellIndex {
         std::uint32_t total = 0;
         for (int s = 0; s < nm; ++s)
           total += merged[static_cast<std::size_t>(s)].end - merged[static_cast<std::size_t>(s)].begin;
+        bool gathered = false;
+        Block home_blk{};
         for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
           if (uniform_h_ || hs_[p] == hmax_) {
+            // Full support: the whole mask, shared by every such particle of the home cell.
+            if (!gathered) home_blk = home_buf.fill(*this, merged.data(), nm, total);
+            gathered = true;
             local_tests += total - 1;
-            kernel(p, merged.data(), nm);
+            kernel(p, home_blk);
           } else {
             // Smaller support: only the mask cells that can reach within h_p (section 4.1).
             const double reach = double(hs_[p]) / cell_size_;
@@ -504,7 +622,7 @@ class CellIndex {
               mt += r.end - r.begin;
             }
             local_tests += mt - 1;
-            kernel(p, mine.data(), nk);
+            kernel(p, own_buf.fill(*this, mine.data(), nk, mt));
           }
         }
       }
@@ -524,10 +642,11 @@ class CellIndex {
     return k;
   }
 
-  static constexpr std::size_t kPad = 4;
+  static constexpr std::size_t kPad = 8;
   static constexpr std::uint32_t kRankSortMax = 96;
 
   int subdivision_ = 1;
+  bool avx2_ = detail::cpu_has_avx2();
   bool force_wide_ = false;
   std::size_t n_ = 0;
   bool wide_ = false;
