@@ -26,10 +26,13 @@
 #include <vector>
 
 #include <omp.h>
-#if defined(__SSE2__)
+// SIMD paths: SSE2 (x86-64 baseline) and AVX2 (run-time dispatch). CELLSPH_NO_SIMD forces the
+// scalar code, CELLSPH_NO_AVX2 stops at SSE2 (build the tests with either to check that path).
+#if defined(__SSE2__) && !defined(CELLSPH_NO_SIMD)
 #include <emmintrin.h>
+#define CELLSPH_CELL_INDEX_SSE2 1
 #endif
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(CELLSPH_NO_AVX2)
+#if defined(CELLSPH_CELL_INDEX_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(CELLSPH_NO_AVX2)
 #include <immintrin.h>
 #define CELLSPH_CELL_INDEX_AVX2 1
 #endif
@@ -431,7 +434,7 @@ class CellIndex {
       return;
     }
 #endif
-#if defined(__SSE2__)
+#if defined(CELLSPH_CELL_INDEX_SSE2)
     const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));  // unsigned order via signed compare
     for (std::uint32_t k = 0; k < L; ++k) {
       const __m128i v = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(in[k])), bias);
@@ -521,7 +524,7 @@ class CellIndex {
     if (avx2_) return detail::hits64_avx2<Dim, Real>(ax, xi, hi2, m);
 #endif
     std::uint64_t bits = 0;
-#if defined(__SSE2__)
+#if defined(CELLSPH_CELL_INDEX_SSE2)
     if constexpr (std::is_same_v<Real, float>) {
       const __m128 h2 = _mm_set1_ps(hi2);
       for (std::uint32_t t = 0; t < m; t += 4) {
@@ -588,10 +591,15 @@ class CellIndex {
         for (std::size_t m = 0; m < M; ++m) {
           const std::uint64_t t = home + deltas_[m];
           std::uint32_t c = cur[m];
+          // A cursor mostly moves 0 or 1 cell per home cell: two branch-free steps, then a loop
+          // that runs only after a gap in the occupied cells.
+          c += cells[c] < t ? 1u : 0u;
+          c += cells[c] < t ? 1u : 0u;
           while (cells[c] < t) ++c;
           cur[m] = c;
-          if (cells[c] == t && c < nc)
-            found[static_cast<std::size_t>(nf++)] = {start[c], start[c + 1], mask_[m].gap2};
+          // Visit only an exact match; the sentinel (c == nc) never is one. Written branch free.
+          found[static_cast<std::size_t>(nf)] = {start[c], start[c + (c < nc ? 1 : 0)], mask_[m].gap2};
+          nf += (cells[c] == t && c < nc) ? 1 : 0;
         }
         // Mask cells found in consecutive sorted cells (neighbours along axis 0) are one range.
         const int nm = merge(found.data(), nf, merged.data());
