@@ -9,6 +9,16 @@
 // hmask.hpp) is ordered the same way, so for consecutive home cells the key of each mask cell only
 // grows: each mask cell keeps a cursor into the sorted cells that only moves forward.
 //
+// Cell coordinates are shifted by the mask radius so that home + offset never leaves its row: the
+// key of each mask cell relative to the home cell is one constant (deltas_), and targets off the
+// grid find no cell. When I + cell bits exceed 64 the keys widen to a 64-bit cell key sorted with a
+// 32-bit index payload (same order); beyond that, CapacityError.
+//
+// Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
+// a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
+// (SSE2) at a time and walks the set bits of the hit mask, with no branch per candidate. find_all
+// counts, then fills, and places each short row by rank.
+//
 // Exactness: the neighbour test is distance2(x[i], x[j]) <= h[i]^2 in Real, the same expression as
 // the all-pairs reference; the mask only decides which candidates reach that test, and it is built
 // from exact cell geometry with the inflated cell size of hmask.hpp.
