@@ -201,11 +201,11 @@ class CellIndex {
   // thread, consecutively, j in key order. Returns the number of distance tests.
   template <class F>
   std::uint64_t for_each_pair(F&& f) const {
-    return traverse([&](std::uint32_t p, const Block& blk) {
+    return traverse<true>([&](std::uint32_t p, const Block& blk) {
       const std::uint32_t i = ids_[p];
       Real xi[Dim];
       for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-      for_each_hit(p, blk, [&](std::uint32_t q) { f(i, ids_[q], dist2(xi, q)); });
+      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) { f(i, j, block_dist2(blk, xi, t)); });
     });
   }
 
@@ -218,7 +218,7 @@ class CellIndex {
       return 0;
     }
     std::uint64_t* counts = out.offsets.data() + 1;
-    const std::uint64_t candidates = traverse([&](std::uint32_t p, const Block& blk) {
+    const std::uint64_t candidates = traverse<false>([&](std::uint32_t p, const Block& blk) {
       Real xi[Dim];
       for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
       const Real hi2 = hs_[p] * hs_[p];
@@ -237,7 +237,7 @@ class CellIndex {
     out.indices.resize(total);
     std::uint32_t* idx = out.indices.data();
     const std::uint64_t* off = out.offsets.data();
-    traverse([&](std::uint32_t p, const Block& blk) {
+    traverse<true>([&](std::uint32_t p, const Block& blk) {
       const std::uint32_t i = ids_[p];
       std::uint32_t* row = idx + off[i];
       const std::uint64_t len = off[i + 1] - off[i];
@@ -245,9 +245,9 @@ class CellIndex {
       std::uint32_t buf[kRankSortMax + 8];
       std::uint32_t* dst = len <= kRankSortMax ? buf : row;
       std::uint64_t c = 0;
-      for_each_hit(p, blk, [&](std::uint32_t q) {
+      for_each_hit(p, blk, [&](std::uint32_t, std::uint32_t j) {
         CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
-        dst[c++] = ids_[q];
+        dst[c++] = j;
       });
       CELLSPH_CHECK(c == len,
                     "cell-index: fill pass found " << c << " neighbours of " << i << ", counted " << len);
@@ -470,19 +470,20 @@ class CellIndex {
   // distance loop runs over one contiguous block instead of a few short ranges; padded by kPad.
   struct Block {
     const Real* x[Dim];
-    const std::uint32_t* q;
+    const std::uint32_t* id;  // particle indices (only when asked for)
     std::uint32_t n;
   };
 
   struct BlockBuffer {
     std::array<std::vector<Real>, Dim> x;
-    std::vector<std::uint32_t> q;
+    std::vector<std::uint32_t> id;
 
     // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
+    template <bool WithIds>
     Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total) {
-      if (q.size() < total + kPad) {
+      if (x[0].size() < total + kPad) {
         for (auto& v : x) v.resize(total + kPad, Real(0));
-        q.resize(total + kPad, 0);
+        id.resize(total + kPad, 0);
       }
       std::uint32_t o = 0;
       for (int s = 0; s < nr; ++s) {
@@ -494,20 +495,32 @@ class CellIndex {
           Real* dst = x[k].data() + o;
           for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(Real));
         }
-        for (std::uint32_t t = 0; t < len; ++t) q[o + t] = b + t;
+        if constexpr (WithIds) std::copy_n(ci.ids_.data() + b, len, id.data() + o);
         o += len;
       }
       Block blk{};
       for (int k = 0; k < Dim; ++k) blk.x[k] = x[k].data();
-      blk.q = q.data();
+      blk.id = id.data();
       blk.n = total;
       return blk;
     }
   };
 
-  // Calls g(q) for every candidate q != p of the block with distance2(x_p, x_q) <= h_p^2.
+  // distance2 order again, on the block's copy of the positions.
+  static Real block_dist2(const Block& blk, const Real* xi, std::uint32_t t) {
+    Real d = xi[0] - blk.x[0][t];
+    Real s = d * d;
+    for (int k = 1; k < Dim; ++k) {
+      d = xi[k] - blk.x[k][t];
+      s += d * d;
+    }
+    return s;
+  }
+
+  // Calls g(t, j) for every candidate t of the block, particle j != p, with distance2 <= h_p^2.
   template <class G>
   void for_each_hit(std::uint32_t p, const Block& blk, G&& g) const {
+    const std::uint32_t i = ids_[p];
     Real xi[Dim];
     for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
     const Real hi2 = hs_[p] * hs_[p];
@@ -516,9 +529,10 @@ class CellIndex {
       // step per neighbour and no branch per candidate.
       std::uint64_t bits = hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b));
       while (bits != 0) {
-        const std::uint32_t q = blk.q[b + static_cast<std::uint32_t>(std::countr_zero(bits))];
+        const std::uint32_t t = b + static_cast<std::uint32_t>(std::countr_zero(bits));
+        const std::uint32_t j = blk.id[t];
         bits &= bits - 1;
-        if (q != p) g(q);
+        if (j != i) g(t, j);
       }
     }
   }
@@ -577,7 +591,7 @@ class CellIndex {
   // boundaries that depend only on the data; each chunk places its cursors by binary search at its
   // first cell, then moves them forward only. kernel(p, block) is called once per particle p (key
   // order) with the candidates its own support needs. Returns the distance tests.
-  template <class Kernel>
+  template <bool WithIds, class Kernel>
   std::uint64_t traverse(Kernel&& kernel) const {
     const std::size_t nc = cell_count();
     if (nc == 0) return 0;
@@ -621,7 +635,7 @@ class CellIndex {
         for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
           if (uniform_h_ || hs_[p] == hmax_) {
             // Full support: the whole mask, shared by every such particle of the home cell.
-            if (!gathered) home_blk = home_buf.fill(*this, merged.data(), nm, total);
+            if (!gathered) home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total);
             gathered = true;
             local_tests += total - 1;
             kernel(p, home_blk);
@@ -640,7 +654,7 @@ class CellIndex {
               mt += r.end - r.begin;
             }
             local_tests += mt - 1;
-            kernel(p, own_buf.fill(*this, mine.data(), nk, mt));
+            kernel(p, own_buf.template fill<WithIds>(*this, mine.data(), nk, mt));
           }
         }
       }
