@@ -1,24 +1,718 @@
 #pragma once
-// PLACEHOLDER: to be replaced by the real implementation of CellIndex.
+// Cell Indexing (paper section 4.2): neighbour search by sorting keys that pack the particle index
+// and its cell coordinates (eq. 17), then streaming through the sorted keys with one cursor per
+// H-mask cell. No hash table and no dense grid: memory is O(n) whatever the bounding box.
+//
+//   key(n, i, j, k) = n + 2^I i + 2^(I+J) j + 2^(I+J+K) k,   2^I > N, 2^J > cells along x, ...  (eq. 17)
+//
+// Sorting the keys orders particles by cell (last axis slowest), then by index. The H-mask (see
+// hmask.hpp) is ordered the same way, so for consecutive home cells the key of each mask cell only
+// grows: each mask cell keeps a cursor into the sorted cells that only moves forward.
+//
+// Cell coordinates are shifted by the mask radius so that home + offset never leaves its row: the
+// key of each mask cell relative to the home cell is one constant (deltas_), and targets off the
+// grid find no cell. When I + cell bits exceed 64 the keys widen to a 64-bit cell key sorted with a
+// 32-bit index payload (same order); beyond that, CapacityError.
+//
+// Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
+// a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
+// (SSE2) at a time and walks the set bits of the hit mask, with no branch per candidate. find_all
+// counts, then fills, and places each short row by rank.
+//
+// Exactness: the neighbour test is distance2(x[i], x[j]) <= h[i]^2 in Real, the same expression as
+// the all-pairs reference; the mask only decides which candidates reach that test, and it is built
+// from exact cell geometry with the inflated cell size of hmask.hpp.
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <span>
-#include <stdexcept>
+#include <sstream>
+#include <type_traits>
+#include <vector>
 
+#include <omp.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+// SIMD paths: SSE2 (x86-64 baseline) and AVX2 (run-time dispatch). CELLSPH_NO_SIMD forces the
+// scalar code, CELLSPH_NO_AVX2 stops at SSE2 (build the tests with either to check that path).
+#if defined(__SSE2__) && !defined(CELLSPH_NO_SIMD)
+#include <emmintrin.h>
+#define CELLSPH_CELL_INDEX_SSE2 1
+#endif
+#if defined(CELLSPH_CELL_INDEX_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(CELLSPH_NO_AVX2)
+#include <immintrin.h>
+#define CELLSPH_CELL_INDEX_AVX2 1
+#endif
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
 #include "cellsph/core/vec.hpp"
+#include "cellsph/neighbors/csr_builder.hpp"
+#include "cellsph/neighbors/hmask.hpp"
 #include "cellsph/neighbors/neighbor_list.hpp"
+#include "cellsph/neighbors/radix_sort.hpp"
 
 namespace cellsph {
+
+namespace detail {
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+// AVX2 versions of CellIndex's two inner loops, chosen at run time when the CPU has AVX2 (the
+// build targets baseline x86-64). Same operations in the same order as the scalar and SSE2 code
+// (no FMA), so every result is identical whichever path runs.
+inline bool cpu_has_avx2() {
+  return __builtin_cpu_supports("avx2");
+}
+
+template <int Dim, class Real>
+__attribute__((target("avx2"))) std::uint64_t hits64_avx2(const Real* const* ax, const Real* xi, Real hi2,
+                                                          std::uint32_t m) {
+  std::uint64_t bits = 0;
+  if constexpr (std::is_same_v<Real, float>) {
+    const __m256 h2 = _mm256_set1_ps(hi2);
+    for (std::uint32_t t = 0; t < m; t += 8) {
+      __m256 d = _mm256_sub_ps(_mm256_set1_ps(xi[0]), _mm256_loadu_ps(ax[0] + t));
+      __m256 s2 = _mm256_mul_ps(d, d);
+      for (int k = 1; k < Dim; ++k) {
+        d = _mm256_sub_ps(_mm256_set1_ps(xi[k]), _mm256_loadu_ps(ax[k] + t));
+        s2 = _mm256_add_ps(s2, _mm256_mul_ps(d, d));
+      }
+      bits |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, h2, _CMP_LE_OQ))) << t;
+    }
+  } else {
+    const __m256d h2 = _mm256_set1_pd(hi2);
+    for (std::uint32_t t = 0; t < m; t += 4) {
+      __m256d d = _mm256_sub_pd(_mm256_set1_pd(xi[0]), _mm256_loadu_pd(ax[0] + t));
+      __m256d s2 = _mm256_mul_pd(d, d);
+      for (int k = 1; k < Dim; ++k) {
+        d = _mm256_sub_pd(_mm256_set1_pd(xi[k]), _mm256_loadu_pd(ax[k] + t));
+        s2 = _mm256_add_pd(s2, _mm256_mul_pd(d, d));
+      }
+      bits |= static_cast<std::uint64_t>(_mm256_movemask_pd(_mm256_cmp_pd(s2, h2, _CMP_LE_OQ))) << t;
+    }
+  }
+  return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
+}
+
+// in[0, L) distinct, with 8 entries of UINT32_MAX after them.
+__attribute__((target("avx2"))) inline void rank_sort_avx2(const std::uint32_t* in, std::uint32_t L,
+                                                           std::uint32_t* out) {
+  const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
+  for (std::uint32_t k = 0; k < L; ++k) {
+    const __m256i v = _mm256_xor_si256(_mm256_set1_epi32(static_cast<int>(in[k])), bias);
+    __m256i acc = _mm256_setzero_si256();
+    for (std::uint32_t m = 0; m < L; m += 8) {
+      const __m256i w = _mm256_xor_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + m)), bias);
+      acc = _mm256_sub_epi32(acc, _mm256_cmpgt_epi32(v, w));
+    }
+    __m128i a = _mm_add_epi32(_mm256_castsi256_si128(acc), _mm256_extracti128_si256(acc, 1));
+    a = _mm_add_epi32(a, _mm_shuffle_epi32(a, 0x4E));
+    a = _mm_add_epi32(a, _mm_shuffle_epi32(a, 0xB1));
+    out[_mm_cvtsi128_si32(a)] = in[k];
+  }
+}
+#else
+inline bool cpu_has_avx2() {
+  return false;
+}
+#endif
+}  // namespace detail
 
 template <int Dim, class Real>
 class CellIndex {
  public:
-  explicit CellIndex(const SearchOptions& /*opt*/ = {}) {}
-  void build(std::span<const Vec<Dim, Real>>, std::span<const Real>) {
-    throw std::logic_error("CellIndex is not implemented yet");
+  using Point = Vec<Dim, Real>;
+
+  explicit CellIndex(const SearchOptions& opt = {}) : subdivision_(opt.subdivision) {
+    if (subdivision_ < 1) {
+      std::ostringstream os;
+      os << "cell-index: subdivision H must be >= 1, got " << subdivision_;
+      throw InputError(os.str());
+    }
   }
+
+  // Forces the wide key layout (64-bit cell key + 32-bit index payload) even when eq. 17's packed
+  // key would fit. For tests and for measuring what the packing saves.
+  void force_wide_keys(bool on) { force_wide_ = on; }
+
+  void build(std::span<const Point> x, std::span<const Real> h) {
+    CELLSPH_CHECK(h.size() == x.size(), "support lengths " << h.size() << " != points " << x.size());
+    clear();
+    n_ = x.size();
+    if (n_ == 0) return;
+    if (n_ > std::numeric_limits<std::uint32_t>::max()) {
+      std::ostringstream os;
+      os << "cell-index: " << n_ << " particles exceed the 32-bit particle index (at most "
+         << std::numeric_limits<std::uint32_t>::max() << ")";
+      throw CapacityError(os.str());
+    }
+    const Bounds b = bounds(x, h);
+    hmax_ = b.hmax;
+    uniform_h_ = b.hmin == b.hmax;
+    // h' = (max h / H) * inflation (section 4.1); any positive size is exact when all h are 0.
+    cell_size_ = b.hmax > Real(0) ? double(b.hmax) / subdivision_ * kCellInflation : 1.0;
+    const double reach = double(b.hmax) / cell_size_;
+    mask_ = h_mask<Dim>(reach);
+    const int pad = mask_radius(reach);
+    for (int k = 0; k < Dim; ++k) origin_[k] = double(b.lo[k]);
+
+    // Bits per axis: cell coordinates are shifted by `pad` so that every mask target (home + offset)
+    // is non-negative and below 2^bits on every axis; targets off the grid then simply find no cell.
+    int cell_bits = 0;
+    for (int k = 0; k < Dim; ++k) {
+      const double cells = std::floor((double(b.hi[k]) - origin_[k]) / cell_size_) + 1.0;
+      if (!(cells + 2.0 * pad < 4294967296.0)) {
+        std::ostringstream os;
+        os << "cell-index: " << cells << " cells along axis " << k << " (extent "
+           << double(b.hi[k]) - origin_[k] << ", cell size " << cell_size_
+           << ") exceed the 2^32 cells per axis a key can hold";
+        throw CapacityError(os.str());
+      }
+      const auto top = static_cast<std::uint64_t>(cells) - 1 + 2 * static_cast<std::uint64_t>(pad);
+      shift_[k] = cell_bits;
+      cell_bits += static_cast<int>(std::bit_width(top));
+    }
+    cell_bits_ = cell_bits;
+    index_bits_ = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(n_)));  // 2^I > N (eq. 17)
+    if (cell_bits > 64) {
+      std::ostringstream os;
+      os << "cell-index: the grid needs " << cell_bits << " bits of cell coordinates (cell size "
+         << cell_size_
+         << "), more than a 64-bit key holds; the points are too spread out for their support length";
+      throw CapacityError(os.str());
+    }
+    wide_ = force_wide_ || index_bits_ + cell_bits > 64;
+
+    deltas_.resize(mask_.size());
+    for (std::size_t m = 0; m < mask_.size(); ++m) {
+      std::uint64_t d = 0;  // two's complement wrap: home + d is exact for in-range targets
+      for (int k = 0; k < Dim; ++k)
+        d += static_cast<std::uint64_t>(static_cast<std::int64_t>(mask_[m].offset[k])) << shift_[k];
+      deltas_[m] = d;
+    }
+
+    sort_particles(x, pad);
+    gather(x, h);
+  }
+
+  // Calls f(i, j, r2) for every ordered pair with j in N(i); all calls for one i come from one
+  // thread, consecutively, j in key order. Returns the number of distance tests.
   template <class F>
-  std::uint64_t for_each_pair(F&&) const { return 0; }
-  [[nodiscard]] std::size_t memory_bytes() const { return 0; }
+  std::uint64_t for_each_pair(F&& f) const {
+    return traverse<true>([&](std::uint32_t p, const Block& blk) {
+      const std::uint32_t i = ids_[p];
+      Real xi[Dim];
+      for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
+      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) { f(i, j, block_dist2(blk, xi, t)); });
+    });
+  }
+
+  // Canonical CSR lists (rows ascending) in two traversals, count then fill, so that nothing but
+  // the lists is allocated at list size. Each row is sorted while it is still in cache.
+  std::uint64_t find_all(NeighborList& out) const {
+    out.offsets.assign(n_ + 1, 0);
+    if (n_ == 0) {
+      out.indices.clear();
+      return 0;
+    }
+    std::uint64_t* counts = out.offsets.data() + 1;
+    const std::uint64_t candidates = traverse<false>([&](std::uint32_t p, const Block& blk) {
+      Real xi[Dim];
+      for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
+      const Real hi2 = hs_[p] * hs_[p];
+      std::uint64_t c = 0;
+      for (std::uint32_t b = 0; b < blk.n; b += 64)
+        c += popcount64(hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b)));
+      // p itself is among its candidates at distance 0 <= h^2 and was counted once.
+      counts[ids_[p]] = c - 1;
+    });
+    for (std::size_t i = 0; i < n_; ++i) out.offsets[i + 1] += out.offsets[i];
+    const std::uint64_t total = out.offsets[n_];
+    if (out.indices.capacity() < total || out.indices.capacity() > total + total / 2) {
+      out.indices.clear();
+      out.indices.shrink_to_fit();  // never hold the old and the new lists at once
+      out.indices.reserve(total);
+      advise_huge_pages(out.indices.data(), total * sizeof(std::uint32_t));
+    }
+    out.indices.resize(total);
+    std::uint32_t* idx = out.indices.data();
+    const std::uint64_t* off = out.offsets.data();
+    traverse<true>([&](std::uint32_t p, const Block& blk) {
+      const std::uint32_t i = ids_[p];
+      std::uint32_t* row = idx + off[i];
+      const std::uint64_t len = off[i + 1] - off[i];
+      // Typical rows are gathered in a small buffer and placed by rank; long ones go to std::sort.
+      std::uint32_t buf[kRankSortMax + 8];
+      std::uint32_t* dst = len <= kRankSortMax ? buf : row;
+      std::uint64_t c = 0;
+      for_each_hit(p, blk, [&](std::uint32_t, std::uint32_t j) {
+        CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
+        dst[c++] = j;
+      });
+      CELLSPH_CHECK(c == len,
+                    "cell-index: fill pass found " << c << " neighbours of " << i << ", counted " << len);
+      if (dst == buf)
+        rank_sort(buf, static_cast<std::uint32_t>(len), row);
+      else
+        std::sort(row, row + len);
+    });
+    return candidates;
+  }
+
+  [[nodiscard]] std::size_t memory_bytes() const {
+    std::size_t s = cells_.capacity() * sizeof(std::uint64_t) +
+                    cell_start_.capacity() * sizeof(std::uint32_t) + hs_.capacity() * sizeof(Real) +
+                    ids_.capacity() * sizeof(std::uint32_t) + deltas_.capacity() * sizeof(std::uint64_t) +
+                    mask_.capacity() * sizeof(MaskCell<Dim>);
+    for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
+    return s;
+  }
+
+  // Introspection for tests and statistics.
+  [[nodiscard]] bool wide_keys() const { return wide_; }
+  [[nodiscard]] int index_bits() const { return index_bits_; }
+  [[nodiscard]] int cell_bits() const { return cell_bits_; }
+  [[nodiscard]] std::size_t cell_count() const { return cells_.empty() ? 0 : cells_.size() - 1; }
+  [[nodiscard]] std::size_t mask_size() const { return mask_.size(); }
+  [[nodiscard]] double cell_size() const { return cell_size_; }
+
+ private:
+  // Particles [begin, end) in key order that lie in one mask cell (or several adjacent ones).
+  struct Range {
+    std::uint32_t begin, end;
+    int gap2;
+  };
+
+  struct Bounds {
+    Point lo, hi;
+    Real hmin, hmax;
+  };
+
+  void clear() {
+    n_ = 0;
+    cells_.clear();
+    cell_start_.clear();
+    for (auto& v : xs_) v.clear();
+    hs_.clear();
+    ids_.clear();
+    wide_ = force_wide_;
+    index_bits_ = cell_bits_ = 0;
+  }
+
+  static Bounds bounds(std::span<const Point> x, std::span<const Real> h) {
+    Bounds all{x[0], x[0], h[0], h[0]};
+    bool finite = true;
+#pragma omp parallel
+    {
+      Bounds loc = all;
+      bool ok = true;
+#pragma omp for schedule(static) nowait
+      for (std::int64_t i = 0; i < static_cast<std::int64_t>(x.size()); ++i) {
+        const auto& p = x[static_cast<std::size_t>(i)];
+        const Real hi = h[static_cast<std::size_t>(i)];
+        for (int k = 0; k < Dim; ++k) {
+          ok = ok && std::isfinite(p[k]);
+          loc.lo[k] = std::min(loc.lo[k], p[k]);
+          loc.hi[k] = std::max(loc.hi[k], p[k]);
+        }
+        ok = ok && std::isfinite(hi) && hi >= Real(0);
+        loc.hmin = std::min(loc.hmin, hi);
+        loc.hmax = std::max(loc.hmax, hi);
+      }
+#pragma omp critical(cellsph_cell_index_bounds)
+      {
+        finite = finite && ok;
+        for (int k = 0; k < Dim; ++k) {
+          all.lo[k] = std::min(all.lo[k], loc.lo[k]);
+          all.hi[k] = std::max(all.hi[k], loc.hi[k]);
+        }
+        all.hmin = std::min(all.hmin, loc.hmin);
+        all.hmax = std::max(all.hmax, loc.hmax);
+      }
+    }
+    CELLSPH_CHECK(finite, "cell-index: non-finite coordinate or support length, or negative support length");
+    return all;
+  }
+
+  std::uint64_t cell_key(const Point& p, int pad) const {
+    std::uint64_t key = 0;
+    for (int k = 0; k < Dim; ++k) {
+      const double c = std::floor((double(p[k]) - origin_[k]) / cell_size_);
+      key |= (static_cast<std::uint64_t>(c) + static_cast<std::uint64_t>(pad)) << shift_[k];
+    }
+    return key;
+  }
+
+  // Sorts the particles by cell and fills ids_ (key order -> particle) and the list of non-empty
+  // cells with their first particle.
+  void sort_particles(std::span<const Point> x, int pad) {
+    const std::size_t n = n_;
+    std::vector<std::uint64_t> keys(n), scratch;
+    std::vector<std::uint64_t> cellkey;  // per particle in key order (wide path only)
+    ids_.resize(n);
+    if (!wide_) {
+      const int I = index_bits_;
+      parallel_for(n, [&](std::size_t i) { keys[i] = (cell_key(x[i], pad) << I) | i; });
+      // The index bits are already in order (keys are made in index order) and LSD passes are
+      // stable, so sorting the cell bits alone gives the full eq. 17 order.
+      radix_sort(keys, scratch, I, I + cell_bits_);
+      const std::uint64_t low = (std::uint64_t{1} << I) - 1;
+      parallel_for(n, [&](std::size_t p) { ids_[p] = static_cast<std::uint32_t>(keys[p] & low); });
+      parallel_for(n, [&](std::size_t p) { keys[p] >>= I; });
+    } else {
+      std::vector<std::uint32_t> payload_scratch;
+      parallel_for(n, [&](std::size_t i) {
+        keys[i] = cell_key(x[i], pad);
+        ids_[i] = static_cast<std::uint32_t>(i);
+      });
+      radix_sort_pairs(keys, ids_, scratch, payload_scratch, 0, cell_bits_);
+    }
+    scratch = {};
+    // keys now holds each particle's cell key in sorted order: extract the distinct cells.
+    const int max_t = max_threads();
+    std::vector<std::size_t> starts(static_cast<std::size_t>(max_t) + 1, 0);
+    int used_t = 1;
+#pragma omp parallel
+    {
+      const auto nt = static_cast<std::size_t>(omp_get_num_threads());
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      const std::size_t b = n * t / nt, e = n * (t + 1) / nt;
+      std::size_t c = 0;
+      for (std::size_t p = b; p < e; ++p) c += (p == 0 || keys[p] != keys[p - 1]);
+      starts[t + 1] = c;
+#pragma omp barrier
+#pragma omp single
+      {
+        used_t = static_cast<int>(nt);
+        for (std::size_t s = 0; s < nt; ++s) starts[s + 1] += starts[s];
+        cells_.resize(starts[nt] + 1);
+        cell_start_.resize(starts[nt] + 1);
+      }
+      std::size_t u = starts[t];
+      for (std::size_t p = b; p < e; ++p)
+        if (p == 0 || keys[p] != keys[p - 1]) {
+          cells_[u] = keys[p];
+          cell_start_[u] = static_cast<std::uint32_t>(p);
+          ++u;
+        }
+    }
+    const std::size_t nc = starts[static_cast<std::size_t>(used_t)];
+    cells_[nc] = std::numeric_limits<std::uint64_t>::max();  // sentinel: stops every cursor
+    cell_start_[nc] = static_cast<std::uint32_t>(n);
+  }
+
+  // Positions and support lengths copied into key order: a cell's particles, and the cells along
+  // axis 0, are then contiguous in memory.
+  void gather(std::span<const Point> x, std::span<const Real> h) {
+    // kPad spare entries: BlockBuffer copies whole groups of kPad past the end of a range.
+    for (auto& v : xs_) v.assign(n_ + kPad, Real(0));
+    hs_.resize(n_);
+    parallel_for(n_, [&](std::size_t p) {
+      const std::uint32_t i = ids_[p];
+      for (int k = 0; k < Dim; ++k) xs_[k][p] = x[i][k];
+      hs_[p] = h[i];
+    });
+  }
+
+  // The same expression, in the same order, as distance2(x[i], x[j]).
+  Real dist2(const Real* xi, std::uint32_t q) const {
+    Real d = xi[0] - xs_[0][q];
+    Real s = d * d;
+    for (int k = 1; k < Dim; ++k) {
+      d = xi[k] - xs_[k][q];
+      s += d * d;
+    }
+    return s;
+  }
+
+  // Asks Linux to back a fresh, still untouched list with 2 MiB pages (THP in "madvise" mode):
+  // first-touching 10^8 bytes in 4 KiB pages costs tens of ms of page faults. Only a hint.
+  static void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    constexpr std::uintptr_t kHuge = std::uintptr_t{1} << 21;
+    if (bytes < 2 * kHuge) return;
+    const auto a = reinterpret_cast<std::uintptr_t>(p);
+    const std::uintptr_t b = (a + kHuge - 1) & ~(kHuge - 1), e = (a + bytes) & ~(kHuge - 1);
+    if (e > b) madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
+#endif
+  }
+
+  static std::uint64_t popcount64(std::uint64_t v) {
+    // SWAR popcount: portable and branch free without -mpopcnt (std::popcount becomes a libgcc call).
+    v = v - ((v >> 1) & 0x5555555555555555ull);
+    v = (v & 0x3333333333333333ull) + ((v >> 2) & 0x3333333333333333ull);
+    v = (v + (v >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return (v * 0x0101010101010101ull) >> 56;
+  }
+
+  // Sorts the distinct values in[0, L) into out by rank: out[#{m : in[m] < in[k]}] = in[k]. No
+  // data-dependent branches, unlike insertion sort on rows that arrive in cell order. in must have
+  // room for 8 entries past L (overwritten).
+  void rank_sort(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) const {
+    for (std::uint32_t t = L; t < L + 8; ++t) in[t] = std::numeric_limits<std::uint32_t>::max();
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+    if (avx2_) {
+      detail::rank_sort_avx2(in, L, out);
+      return;
+    }
+#endif
+#if defined(CELLSPH_CELL_INDEX_SSE2)
+    const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));  // unsigned order via signed compare
+    for (std::uint32_t k = 0; k < L; ++k) {
+      const __m128i v = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(in[k])), bias);
+      __m128i acc = _mm_setzero_si128();
+      for (std::uint32_t m = 0; m < L; m += 4) {
+        const __m128i w = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + m)), bias);
+        acc = _mm_sub_epi32(acc, _mm_cmplt_epi32(w, v));
+      }
+      acc = _mm_add_epi32(acc, _mm_shuffle_epi32(acc, 0x4E));
+      acc = _mm_add_epi32(acc, _mm_shuffle_epi32(acc, 0xB1));
+      out[_mm_cvtsi128_si32(acc)] = in[k];
+    }
+#else
+    for (std::uint32_t k = 0; k < L; ++k) {
+      std::uint32_t rank = 0;
+      for (std::uint32_t m = 0; m < L; ++m) rank += in[m] < in[k] ? 1u : 0u;
+      out[rank] = in[k];
+    }
+#endif
+  }
+
+  // A particle's candidates copied side by side (positions and key-order index q), so that the
+  // distance loop runs over one contiguous block instead of a few short ranges; padded by kPad.
+  struct Block {
+    const Real* x[Dim];
+    const std::uint32_t* id;  // particle indices (only when asked for)
+    std::uint32_t n;
+  };
+
+  struct BlockBuffer {
+    std::array<std::vector<Real>, Dim> x;
+    std::vector<std::uint32_t> id;
+
+    // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
+    template <bool WithIds>
+    Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total) {
+      if (x[0].size() < total + kPad) {
+        for (auto& v : x) v.resize(total + kPad, Real(0));
+        id.resize(total + kPad, 0);
+      }
+      std::uint32_t o = 0;
+      for (int s = 0; s < nr; ++s) {
+        const std::uint32_t b = r[s].begin, len = r[s].end - r[s].begin;
+        // Whole groups of kPad: fixed-size copies the compiler inlines (ranges are ~10-30 long,
+        // too short for a memmove call to pay); the overshoot lands in padding.
+        for (int k = 0; k < Dim; ++k) {
+          const Real* src = ci.xs_[k].data() + b;
+          Real* dst = x[k].data() + o;
+          for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(Real));
+        }
+        if constexpr (WithIds) std::copy_n(ci.ids_.data() + b, len, id.data() + o);
+        o += len;
+      }
+      Block blk{};
+      for (int k = 0; k < Dim; ++k) blk.x[k] = x[k].data();
+      blk.id = id.data();
+      blk.n = total;
+      return blk;
+    }
+  };
+
+  // distance2 order again, on the block's copy of the positions.
+  static Real block_dist2(const Block& blk, const Real* xi, std::uint32_t t) {
+    Real d = xi[0] - blk.x[0][t];
+    Real s = d * d;
+    for (int k = 1; k < Dim; ++k) {
+      d = xi[k] - blk.x[k][t];
+      s += d * d;
+    }
+    return s;
+  }
+
+  // Calls g(t, j) for every candidate t of the block, particle j != p, with distance2 <= h_p^2.
+  template <class G>
+  void for_each_hit(std::uint32_t p, const Block& blk, G&& g) const {
+    const std::uint32_t i = ids_[p];
+    Real xi[Dim];
+    for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
+    const Real hi2 = hs_[p] * hs_[p];
+    for (std::uint32_t b = 0; b < blk.n; b += 64) {
+      // About 1 candidate in 7 is a neighbour: iterating the set bits of a hit mask costs one
+      // step per neighbour and no branch per candidate.
+      std::uint64_t bits = hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b));
+      while (bits != 0) {
+        const std::uint32_t t = b + static_cast<std::uint32_t>(std::countr_zero(bits));
+        const std::uint32_t j = blk.id[t];
+        bits &= bits - 1;
+        if (j != i) g(t, j);
+      }
+    }
+  }
+
+  // Bit t set when distance2(xi, x_{b+t}) <= hi2 for the block's candidates b + t, t < m <= 64.
+  // Computed 8 floats (AVX2) or 4 (SSE2) at a time with the same operations in the same order as
+  // distance2, so the test is bit-identical to the all-pairs reference. Reads up to kPad entries
+  // past b + m (padding).
+  std::uint64_t hits64(const Block& blk, const Real* xi, Real hi2, std::uint32_t b, std::uint32_t m) const {
+    const Real* ax[Dim];
+    for (int k = 0; k < Dim; ++k) ax[k] = blk.x[k] + b;
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+    if (avx2_) return detail::hits64_avx2<Dim, Real>(ax, xi, hi2, m);
+#endif
+    std::uint64_t bits = 0;
+#if defined(CELLSPH_CELL_INDEX_SSE2)
+    if constexpr (std::is_same_v<Real, float>) {
+      const __m128 h2 = _mm_set1_ps(hi2);
+      for (std::uint32_t t = 0; t < m; t += 4) {
+        __m128 d = _mm_sub_ps(_mm_set1_ps(xi[0]), _mm_loadu_ps(ax[0] + t));
+        __m128 s2 = _mm_mul_ps(d, d);
+        for (int k = 1; k < Dim; ++k) {
+          d = _mm_sub_ps(_mm_set1_ps(xi[k]), _mm_loadu_ps(ax[k] + t));
+          s2 = _mm_add_ps(s2, _mm_mul_ps(d, d));
+        }
+        bits |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, h2))) << t;
+      }
+    } else if constexpr (std::is_same_v<Real, double>) {
+      const __m128d h2 = _mm_set1_pd(hi2);
+      for (std::uint32_t t = 0; t < m; t += 2) {
+        __m128d d = _mm_sub_pd(_mm_set1_pd(xi[0]), _mm_loadu_pd(ax[0] + t));
+        __m128d s2 = _mm_mul_pd(d, d);
+        for (int k = 1; k < Dim; ++k) {
+          d = _mm_sub_pd(_mm_set1_pd(xi[k]), _mm_loadu_pd(ax[k] + t));
+          s2 = _mm_add_pd(s2, _mm_mul_pd(d, d));
+        }
+        bits |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmple_pd(s2, h2))) << t;
+      }
+    } else
+#endif
+    {
+      for (std::uint32_t t = 0; t < m; ++t) {
+        Real d = xi[0] - ax[0][t];
+        Real s2 = d * d;
+        for (int k = 1; k < Dim; ++k) {
+          d = xi[k] - ax[k][t];
+          s2 += d * d;
+        }
+        bits |= static_cast<std::uint64_t>(s2 <= hi2) << t;
+      }
+    }
+    return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
+  }
+
+  // The streaming traversal of section 4.2. The sorted cells are split into chunks with
+  // boundaries that depend only on the data; each chunk places its cursors by binary search at its
+  // first cell, then moves them forward only. kernel(p, block) is called once per particle p (key
+  // order) with the candidates its own support needs. Returns the distance tests.
+  template <bool WithIds, class Kernel>
+  std::uint64_t traverse(Kernel&& kernel) const {
+    const std::size_t nc = cell_count();
+    if (nc == 0) return 0;
+    const std::size_t M = mask_.size();
+    // About 4096 particles per chunk.
+    const std::size_t grain = std::max<std::size_t>(1, nc * 4096 / n_);
+    const std::uint64_t* cells = cells_.data();
+    const std::uint32_t* start = cell_start_.data();
+    std::atomic<std::uint64_t> tests{0};
+    parallel_chunks(nc, grain, [&](std::size_t u0, std::size_t u1) {
+      std::vector<std::uint32_t> cur(M);
+      std::vector<Range> found(M), merged(M), mine(M);
+      BlockBuffer home_buf, own_buf;
+      for (std::size_t m = 0; m < M; ++m)
+        cur[m] =
+            static_cast<std::uint32_t>(std::lower_bound(cells, cells + nc, cells[u0] + deltas_[m]) - cells);
+      std::uint64_t local_tests = 0;
+      for (std::size_t u = u0; u < u1; ++u) {
+        const std::uint64_t home = cells[u];
+        int nf = 0;
+        for (std::size_t m = 0; m < M; ++m) {
+          const std::uint64_t t = home + deltas_[m];
+          std::uint32_t c = cur[m];
+          // A cursor mostly moves 0 or 1 cell per home cell: two branch-free steps, then a loop
+          // that runs only after a gap in the occupied cells.
+          c += cells[c] < t ? 1u : 0u;
+          c += cells[c] < t ? 1u : 0u;
+          while (cells[c] < t) ++c;
+          cur[m] = c;
+          // Visit only an exact match; the sentinel (c == nc) never is one. Written branch free.
+          found[static_cast<std::size_t>(nf)] = {start[c], start[c + (c < nc ? 1 : 0)], mask_[m].gap2};
+          nf += (cells[c] == t && c < nc) ? 1 : 0;
+        }
+        // Mask cells found in consecutive sorted cells (neighbours along axis 0) are one range.
+        const int nm = merge(found.data(), nf, merged.data());
+        std::uint32_t total = 0;
+        for (int s = 0; s < nm; ++s)
+          total += merged[static_cast<std::size_t>(s)].end - merged[static_cast<std::size_t>(s)].begin;
+        bool gathered = false;
+        Block home_blk{};
+        for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
+          if (uniform_h_ || hs_[p] == hmax_) {
+            // Full support: the whole mask, shared by every such particle of the home cell.
+            if (!gathered) home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total);
+            gathered = true;
+            local_tests += total - 1;
+            kernel(p, home_blk);
+          } else {
+            // Smaller support: only the mask cells that can reach within h_p (section 4.1).
+            const double reach = double(hs_[p]) / cell_size_;
+            int nk = 0;
+            std::uint32_t mt = 0;
+            for (int s = 0; s < nf; ++s) {
+              const Range& r = found[static_cast<std::size_t>(s)];
+              if (!mask_keeps(r.gap2, reach)) continue;
+              if (nk > 0 && mine[static_cast<std::size_t>(nk - 1)].end == r.begin)
+                mine[static_cast<std::size_t>(nk - 1)].end = r.end;
+              else
+                mine[static_cast<std::size_t>(nk++)] = r;
+              mt += r.end - r.begin;
+            }
+            local_tests += mt - 1;
+            kernel(p, own_buf.template fill<WithIds>(*this, mine.data(), nk, mt));
+          }
+        }
+      }
+      tests.fetch_add(local_tests, std::memory_order_relaxed);
+    });
+    return tests.load();
+  }
+
+  static int merge(const Range* in, int n, Range* out) {
+    int k = 0;
+    for (int s = 0; s < n; ++s) {
+      if (k > 0 && out[k - 1].end == in[s].begin)
+        out[k - 1].end = in[s].end;
+      else
+        out[k++] = in[s];
+    }
+    return k;
+  }
+
+  static constexpr std::size_t kPad = 8;
+  static constexpr std::uint32_t kRankSortMax = 96;
+
+  int subdivision_ = 1;
+  bool avx2_ = detail::cpu_has_avx2();
+  bool force_wide_ = false;
+  std::size_t n_ = 0;
+  bool wide_ = false;
+  bool uniform_h_ = true;
+  Real hmax_ = 0;
+  double cell_size_ = 1.0;
+  std::array<double, Dim> origin_{};
+  std::array<int, Dim> shift_{};
+  int index_bits_ = 0;
+  int cell_bits_ = 0;
+  std::vector<MaskCell<Dim>> mask_;
+  std::vector<std::uint64_t> deltas_;      // key offset of each mask cell, mod 2^64
+  std::vector<std::uint64_t> cells_;       // distinct cell keys in order, + UINT64_MAX sentinel
+  std::vector<std::uint32_t> cell_start_;  // first particle (key order) of each cell, + n
+  std::array<std::vector<Real>, Dim> xs_;  // positions in key order, one array per axis
+  std::vector<Real> hs_;                   // support lengths in key order
+  std::vector<std::uint32_t> ids_;         // key order -> particle index
 };
 
 }  // namespace cellsph

@@ -59,7 +59,15 @@ class NeighborSearch {
 
   void find_all(NeighborList& out) {
     Stopwatch sw;
-    stats_.candidates = std::visit([&](auto& m) { return build_csr(m, n_, out); }, impl_);
+    // A method may provide its own CSR builder (same canonical output, faster); else the generic one.
+    stats_.candidates = std::visit(
+        [&](auto& m) -> std::uint64_t {
+          if constexpr (requires { m.find_all(out); })
+            return m.find_all(out);
+          else
+            return build_csr(m, n_, out);
+        },
+        impl_);
     stats_.query_ms = sw.ms();
     stats_.pairs = out.pairs();
     stats_.memory_bytes = structure_bytes() + out.memory_bytes();

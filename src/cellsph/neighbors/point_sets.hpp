@@ -26,7 +26,7 @@ std::vector<Vec<Dim, Real>> jittered_lattice(std::size_t n, Real s, Real jitter,
     for (int k = 0; k < Dim; ++k) {
       const std::size_t c = r % side;
       r /= side;
-      p[k] = static_cast<Real>((double(c) + jitter * u(rng)) * double(s));
+      p[k] = static_cast<Real>((double(c) + double(jitter) * u(rng)) * double(s));
     }
     x.push_back(p);
   }

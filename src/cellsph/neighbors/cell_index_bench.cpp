@@ -1,0 +1,152 @@
+// Cell Indexing on the reference case: 10^6 points of a jittered cubic lattice (spacing 1,
+// jitter 0.01), r = 2 (about 33 neighbours each), structure + all CSR lists with 2 threads.
+// Also our radix sort against std::sort on 10^6 keys.
+//
+// Time is wall clock; the CPU column is the whole process (all threads). On a shared machine run
+// with OMP_WAIT_POLICY=passive so that CPU time counts work, not threads spinning at barriers.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/core/timer.hpp"
+#include "cellsph/neighbors/cell_index.hpp"
+#include "cellsph/neighbors/point_sets.hpp"
+#include "cellsph/neighbors/radix_sort.hpp"
+
+namespace cellsph {
+namespace {
+
+const std::vector<Vec<3, float>>& lattice_1e6() {
+  static const auto x = point_sets::jittered_lattice<3, float>(1000000, 1.0f, 0.01f);
+  return x;
+}
+
+// Build + find_all, as `cellsph neighbors` runs it. Arg: subdivision H.
+void BM_CellIndexBuildAndLists(benchmark::State& state) {
+  ScopedThreads threads(2);
+  const auto& x = lattice_1e6();
+  const std::vector<float> h(x.size(), 2.0f);
+  CellIndex<3, float> ci({.method = Method::CellIndex, .subdivision = static_cast<int>(state.range(0))});
+  NeighborList nl;
+  double build_ms = 0, query_ms = 0;
+  std::uint64_t cand = 0;
+  for (auto _ : state) {
+    Stopwatch sw;
+    ci.build(x, h);
+    build_ms += sw.ms();
+    sw.reset();
+    cand = ci.find_all(nl);
+    query_ms += sw.ms();
+    benchmark::DoNotOptimize(nl.indices.data());
+  }
+  const auto it = static_cast<double>(state.iterations());
+  state.counters["build_ms"] = build_ms / it;
+  state.counters["query_ms"] = query_ms / it;
+  state.counters["pairs"] = static_cast<double>(nl.pairs());
+  state.counters["cand_per_nb"] = static_cast<double>(cand) / static_cast<double>(nl.pairs());
+  state.counters["cells"] = static_cast<double>(ci.cell_count());
+  state.counters["mask"] = static_cast<double>(ci.mask_size());
+  state.counters["struct_MB"] = static_cast<double>(ci.memory_bytes()) / 1e6;
+  state.counters["lists_MB"] = static_cast<double>(nl.memory_bytes()) / 1e6;
+}
+BENCHMARK(BM_CellIndexBuildAndLists)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+// Fresh output lists every iteration: includes the page faults of a first allocation.
+void BM_CellIndexBuildAndFreshLists(benchmark::State& state) {
+  ScopedThreads threads(2);
+  const auto& x = lattice_1e6();
+  const std::vector<float> h(x.size(), 2.0f);
+  CellIndex<3, float> ci({.method = Method::CellIndex, .subdivision = static_cast<int>(state.range(0))});
+  for (auto _ : state) {
+    ci.build(x, h);
+    NeighborList nl;
+    ci.find_all(nl);
+    benchmark::DoNotOptimize(nl.indices.data());
+  }
+}
+BENCHMARK(BM_CellIndexBuildAndFreshLists)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+// The visitor alone (count neighbours, no list), the loop SPH sums use.
+void BM_CellIndexVisitor(benchmark::State& state) {
+  ScopedThreads threads(2);
+  const auto& x = lattice_1e6();
+  const std::vector<float> h(x.size(), 2.0f);
+  CellIndex<3, float> ci({.method = Method::CellIndex, .subdivision = static_cast<int>(state.range(0))});
+  ci.build(x, h);
+  std::vector<std::uint32_t> count(x.size());
+  for (auto _ : state) {
+    ci.for_each_pair([&](std::uint32_t i, std::uint32_t, float) { ++count[i]; });
+    benchmark::DoNotOptimize(count.data());
+  }
+}
+BENCHMARK(BM_CellIndexVisitor)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+std::vector<std::uint64_t> random_keys(std::size_t n, std::uint64_t mask) {
+  std::mt19937_64 rng(5);
+  std::vector<std::uint64_t> k(n);
+  for (auto& v : k) v = rng() & mask;
+  return k;
+}
+
+// Arg: number of random low bits per key (64: full keys; 38: eq. 17 keys of 10^6 particles).
+void BM_RadixSort(benchmark::State& state) {
+  ScopedThreads threads(static_cast<int>(state.range(1)));
+  const int bits = static_cast<int>(state.range(0));
+  const auto keys = random_keys(1000000, bits == 64 ? ~0ull : (1ull << bits) - 1);
+  std::vector<std::uint64_t> k, scratch;
+  for (auto _ : state) {
+    state.PauseTiming();
+    k = keys;
+    state.ResumeTiming();
+    radix_sort(k, scratch);
+    benchmark::DoNotOptimize(k.data());
+  }
+}
+BENCHMARK(BM_RadixSort)
+    ->Args({64, 1})
+    ->Args({64, 2})
+    ->Args({38, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+void BM_StdSort(benchmark::State& state) {
+  const int bits = static_cast<int>(state.range(0));
+  const auto keys = random_keys(1000000, bits == 64 ? ~0ull : (1ull << bits) - 1);
+  std::vector<std::uint64_t> k;
+  for (auto _ : state) {
+    state.PauseTiming();
+    k = keys;
+    state.ResumeTiming();
+    std::sort(k.begin(), k.end());
+    benchmark::DoNotOptimize(k.data());
+  }
+}
+BENCHMARK(BM_StdSort)
+    ->Arg(64)
+    ->Arg(38)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace cellsph

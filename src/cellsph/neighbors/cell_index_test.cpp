@@ -1,0 +1,265 @@
+// Cell Indexing against the all-pairs reference: exact CSR equality on point sets chosen to break
+// cell arithmetic (points on cell faces, far offsets, duplicates, variable h, both key layouts).
+#include "cellsph/neighbors/cell_index.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/neighbors/neighbor_search.hpp"
+#include "cellsph/neighbors/point_sets.hpp"
+
+namespace cellsph {
+namespace {
+
+template <int Dim, class Real>
+using Points = std::vector<Vec<Dim, Real>>;
+
+template <int Dim, class Real>
+NeighborList all_pairs(const Points<Dim, Real>& x, const std::vector<Real>& h) {
+  NeighborSearch<Dim, Real> ns({.method = Method::AllPairs});
+  ns.build(x, h);
+  NeighborList nl;
+  ns.find_all(nl);
+  return nl;
+}
+
+// Checks the visitor contract: every call for one i on one thread, consecutively, and r2 equal to
+// distance2 bit for bit. Returns the lists built from the visitor (rows sorted).
+template <int Dim, class Real>
+NeighborList via_visitor(const CellIndex<Dim, Real>& ci, const Points<Dim, Real>& x) {
+  const std::size_t n = x.size();
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> per_thread(
+      static_cast<std::size_t>(max_threads()));
+  bool r2_exact = true;
+  ci.for_each_pair([&](std::uint32_t i, std::uint32_t j, Real r2) {
+    per_thread[static_cast<std::size_t>(thread_id())].push_back({i, j});
+    if (r2 != distance2(x[i], x[j])) r2_exact = false;  // races only ever write false
+  });
+  EXPECT_TRUE(r2_exact);
+  std::vector<int> owner(n, -1);
+  std::vector<std::vector<std::uint32_t>> rows(n);
+  for (std::size_t t = 0; t < per_thread.size(); ++t) {
+    std::uint32_t last = 0;
+    bool any = false;
+    for (auto [i, j] : per_thread[t]) {
+      if (!any || i != last) {
+        EXPECT_EQ(owner[i], -1) << "calls for i=" << i << " are not consecutive on one thread";
+        owner[i] = static_cast<int>(t);
+      }
+      any = true;
+      last = i;
+      rows[i].push_back(j);
+    }
+  }
+  NeighborList nl;
+  nl.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::sort(rows[i].begin(), rows[i].end());
+    nl.offsets[i + 1] = nl.offsets[i] + rows[i].size();
+    nl.indices.insert(nl.indices.end(), rows[i].begin(), rows[i].end());
+  }
+  return nl;
+}
+
+// Cell Indexing equals all-pairs for H = 1..3, both key layouts, 1 and 2 threads, through
+// find_all (own CSR builder), the generic builder over the visitor, and NeighborSearch.
+template <int Dim, class Real>
+void expect_exact(const Points<Dim, Real>& x, const std::vector<Real>& h, const std::string& what) {
+  const NeighborList ref = all_pairs<Dim, Real>(x, h);
+  for (int H : {1, 2, 3})
+    for (bool wide : {false, true})
+      for (int threads : {1, 2}) {
+        SCOPED_TRACE(what + " H=" + std::to_string(H) + (wide ? " wide" : " packed") +
+                     " threads=" + std::to_string(threads));
+        ScopedThreads st(threads);
+        CellIndex<Dim, Real> ci({.method = Method::CellIndex, .subdivision = H});
+        ci.force_wide_keys(wide);
+        ci.build(x, h);
+        EXPECT_EQ(ci.wide_keys(), wide);
+        NeighborList a;
+        const std::uint64_t cand = ci.find_all(a);
+        EXPECT_EQ(a.offsets, ref.offsets);
+        EXPECT_EQ(a.indices, ref.indices);
+        EXPECT_GE(cand, a.pairs());
+        NeighborList b;
+        EXPECT_EQ(build_csr(ci, x.size(), b), cand);
+        EXPECT_EQ(b.indices, ref.indices);
+        const NeighborList c = via_visitor(ci, x);
+        EXPECT_EQ(c.offsets, ref.offsets);
+        EXPECT_EQ(c.indices, ref.indices);
+        if (!wide) {
+          NeighborSearch<Dim, Real> ns({.method = Method::CellIndex, .subdivision = H});
+          ns.build(x, h);
+          NeighborList d;
+          ns.find_all(d);
+          EXPECT_EQ(d.indices, ref.indices);
+          EXPECT_EQ(ns.stats().candidates, cand);
+        }
+      }
+}
+
+template <int Dim, class Real>
+std::vector<Real> constant_h(std::size_t n, double r) {
+  return std::vector<Real>(n, static_cast<Real>(r));
+}
+
+// Support lengths spread over a 10x range [0.25 r, 2.5 r].
+template <class Real>
+std::vector<Real> variable_h(std::size_t n, double r, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.25, 2.5);
+  std::vector<Real> h(n);
+  for (auto& v : h) v = static_cast<Real>(r * u(rng));
+  return h;
+}
+
+template <int Dim, class Real>
+void run_point_sets() {
+  {
+    const auto x = point_sets::uniform_random<Dim, Real>(1200, Real(1));
+    expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), 1.5), "uniform r=1.5");
+    expect_exact<Dim, Real>(x, variable_h<Real>(x.size(), 1.0, 5), "uniform variable h");
+  }
+  {
+    const auto x = point_sets::clustered<Dim, Real>(1000, Real(1), 3);
+    expect_exact<Dim, Real>(x, variable_h<Real>(x.size(), 0.7, 6), "clustered variable h");
+  }
+  {
+    // Lattice of spacing 1 with h = 1 and 2: many pairs at distance exactly h.
+    const auto x = point_sets::jittered_lattice<Dim, Real>(Dim == 2 ? 900 : 1000, Real(1), Real(0));
+    expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), 1.0), "lattice h=1");
+    expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), 2.0), "lattice h=2");
+  }
+  {
+    // Points exactly on the faces of the H = 1 and H = 2 cells (multiples of the cell size).
+    for (int H : {1, 2}) {
+      const double r = 1.0;
+      const double c = r / H * kCellInflation;
+      auto x = point_sets::jittered_lattice<Dim, Real>(Dim == 2 ? 400 : 512, Real(1), Real(0));
+      for (auto& p : x)
+        for (int k = 0; k < Dim; ++k) p[k] = static_cast<Real>(double(p[k]) * c);
+      expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), r), "cell faces H=" + std::to_string(H));
+    }
+  }
+  {
+    // Negative and far-off coordinates (1e6 offset), float rounding included.
+    for (double off : {-1.0e6, 1.0e6, -37.5}) {
+      auto x = point_sets::uniform_random<Dim, Real>(800, Real(1));
+      for (auto& p : x)
+        for (int k = 0; k < Dim; ++k) p[k] = static_cast<Real>(double(p[k]) + off);
+      expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), 1.3), "offset " + std::to_string(off));
+    }
+  }
+  {
+    // Duplicates: every point three times (distance 0 pairs, equal keys but for the index).
+    auto x = point_sets::uniform_random<Dim, Real>(300, Real(1));
+    const auto base = x;
+    x.insert(x.end(), base.begin(), base.end());
+    x.insert(x.end(), base.begin(), base.end());
+    expect_exact<Dim, Real>(x, variable_h<Real>(x.size(), 1.0, 7), "duplicates");
+  }
+  {
+    // All points in one cell.
+    auto x = point_sets::uniform_random<Dim, Real>(200, Real(0.001));
+    expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), 10.0), "one cell");
+  }
+  {
+    Points<Dim, Real> one(1);
+    one[0][0] = Real(3);
+    expect_exact<Dim, Real>(one, constant_h<Dim, Real>(1, 1.0), "one point");
+    expect_exact<Dim, Real>(Points<Dim, Real>{}, std::vector<Real>{}, "no points");
+    // Zero support: only exact duplicates are neighbours.
+    auto x = point_sets::jittered_lattice<Dim, Real>(16, Real(1), Real(0));
+    x.push_back(x[3]);
+    expect_exact<Dim, Real>(x, constant_h<Dim, Real>(x.size(), 0.0), "h = 0");
+  }
+}
+
+TEST(CellIndex, MatchesAllPairs2DFloat) {
+  run_point_sets<2, float>();
+}
+TEST(CellIndex, MatchesAllPairs2DDouble) {
+  run_point_sets<2, double>();
+}
+TEST(CellIndex, MatchesAllPairs3DFloat) {
+  run_point_sets<3, float>();
+}
+TEST(CellIndex, MatchesAllPairs3DDouble) {
+  run_point_sets<3, double>();
+}
+
+TEST(CellIndex, WidensKeysWhenEq17DoesNotFit) {
+  // 2^28 cells per axis in 2D: 58 bits of cell coordinates plus 9 index bits exceed 64, so the
+  // packed key cannot hold it; the wide layout must take over and stay exact.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 6.0);
+  Points<2, double> x;
+  for (int i = 0; i < 300; ++i) x.push_back({{u(rng), u(rng)}});
+  for (int i = 0; i < 100; ++i) x.push_back({{2.7e8 + u(rng), 2.7e8 + u(rng)}});
+  for (int i = 0; i < 50; ++i) x.push_back({{u(rng), 2.7e8 + u(rng)}});
+  const std::vector<double> h(x.size(), 1.0);
+  CellIndex<2, double> ci;
+  ci.build(x, h);
+  EXPECT_TRUE(ci.wide_keys());
+  EXPECT_GT(ci.index_bits() + ci.cell_bits(), 64);
+  NeighborList a;
+  ci.find_all(a);
+  const NeighborList ref = all_pairs<2, double>(x, h);
+  EXPECT_EQ(a.offsets, ref.offsets);
+  EXPECT_EQ(a.indices, ref.indices);
+  EXPECT_EQ(via_visitor(ci, x).indices, ref.indices);
+}
+
+TEST(CellIndex, PacksKeysWhenTheyFit) {
+  const auto x = point_sets::jittered_lattice<3, float>(1000, 1.0f, 0.01f);
+  CellIndex<3, float> ci({.subdivision = 2});
+  ci.build(x, std::vector<float>(x.size(), 2.0f));
+  EXPECT_FALSE(ci.wide_keys());
+  EXPECT_EQ(ci.index_bits(), 10);  // 2^10 > 1000
+  EXPECT_LE(ci.index_bits() + ci.cell_bits(), 64);
+}
+
+TEST(CellIndex, RefusesGridsBeyondSixtyFourBits) {
+  // 2^31 cells on each of three axes: 96 bits of cell key, no layout holds it.
+  Points<3, double> x = {{{0, 0, 0}}, {{2.2e9, 2.2e9, 2.2e9}}};
+  const std::vector<double> h(2, 1.0);
+  CellIndex<3, double> ci;
+  EXPECT_THROW(ci.build(x, h), CapacityError);
+  // 2^33 cells along one axis: a cell coordinate alone does not fit 32 bits.
+  Points<2, double> y = {{{0, 0}}, {{9.0e9, 0}}};
+  CellIndex<2, double> cj;
+  try {
+    cj.build(y, std::vector<double>(2, 1.0));
+    ADD_FAILURE() << "expected CapacityError";
+  } catch (const CapacityError& e) {
+    EXPECT_NE(std::string(e.what()).find("axis 0"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CellIndex, RejectsSubdivisionBelowOne) {
+  EXPECT_THROW((CellIndex<3, float>({.subdivision = 0})), InputError);
+}
+
+TEST(CellIndex, CandidatesShrinkWithSubdivision) {
+  // The H-mask hugs the sphere more tightly as H grows (paper section 4.1).
+  const auto x = point_sets::jittered_lattice<3, float>(4096, 1.0f, 0.01f);
+  const std::vector<float> h(x.size(), 2.0f);
+  std::map<int, std::uint64_t> cand;
+  for (int H : {1, 2, 3}) {
+    CellIndex<3, float> ci({.subdivision = H});
+    ci.build(x, h);
+    NeighborList nl;
+    cand[H] = ci.find_all(nl);
+  }
+  EXPECT_LT(cand[2], cand[1]);
+  EXPECT_LT(cand[3], cand[2]);
+}
+
+}  // namespace
+}  // namespace cellsph
