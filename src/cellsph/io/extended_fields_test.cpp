@@ -78,7 +78,7 @@ TEST(ExtendedFields, CsvAppendsTheNewColumns) {
   test::TempDir dir("ext_csv");
   const auto e = make_extended(3);
   EXPECT_EQ((csv_header_any<ExtendedParticles<2, float>>()),
-            "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,kind,flag,id,"
+            "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind,flag,id,"
             "normal_x,normal_y");
   write_csv_any(e, dir / "e.csv", {});
   const std::string text = test::slurp(dir / "e.csv");
