@@ -333,8 +333,8 @@ TEST(DamBreak, KoshizukaOkaSurgeFront) {
   add_box_walls<2, double>(p, V2{{0, 0}}, V2{{4 * a, 3 * a}}, s, 2, true, 0, rho0 * s * s);
 
   // Read the published front positions (t [s], x [m]).
-  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/../../shared/validation/koshizuka_oka_1996_front.tsv");
-  if (!in) in.open("/work/shared/validation/koshizuka_oka_1996_front.tsv");
+  // The published data, copied into the repository (data/validation/, with its source in the header).
+  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/data/validation/koshizuka_oka_1996_front.tsv");
   ASSERT_TRUE(in) << "koshizuka_oka_1996_front.tsv not found";
   std::vector<std::pair<double, double>> ref;
   for (std::string line; std::getline(in, line);) {
