@@ -107,6 +107,28 @@ TEST(CliRun, ResumeContinuesBitForBit) {
   EXPECT_EQ(read_file(dir / "whole" / "frames.csv"), read_file(dir / "parts" / "frames.csv"));
 }
 
+TEST(CliRun, ResumeExtendsAFinishedRunAndRestartsWithoutCheckpoint) {
+  TempDir dir;
+  std::string scene = kTiny;
+  scene.replace(scene.find("\"checkpoint_every\": 1"), 21, "\"checkpoint_every\": 100");
+  write_file(dir / "tiny.json", scene);
+  auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "whole") + " --quiet --format csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // No frame reaches a checkpoint here; the end state is saved, so the run can be extended.
+  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "ext") + " --quiet --format csv --until 0.05");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run_cli(dir, "run --resume " + q(dir / "ext") + " --until 0.1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(read_file(dir / "whole" / "frame_00005.csv") == read_file(dir / "ext" / "frame_00005.csv"));
+  // A run killed before any checkpoint starts again from t = 0 (same result, deterministic).
+  fs::remove(dir / "ext" / "checkpoint.bin");
+  r = run_cli(dir, "run --resume " + q(dir / "ext") + " --until 0.1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("starting again from t = 0"), std::string::npos) << r.err;
+  EXPECT_TRUE(read_file(dir / "whole" / "frame_00005.csv") == read_file(dir / "ext" / "frame_00005.csv"));
+  EXPECT_EQ(read_file(dir / "whole" / "frames.csv"), read_file(dir / "ext" / "frames.csv"));
+}
+
 TEST(CliRun, SameResultWithEveryNeighbourMethod) {
   TempDir dir;
   write_file(dir / "tiny.json", kTiny);

@@ -93,9 +93,16 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
 
   LoopState loop;
   const auto ckpt_path = out / kCheckpointFile;
+  if (resuming && !std::filesystem::exists(ckpt_path)) {
+    // Killed before its first checkpoint: the run is deterministic, so starting again from t = 0 gives
+    // exactly what continuing would have.
+    if (!opt.quiet)
+      std::fprintf(stderr, "cellsph: %s has no checkpoint yet; starting again from t = 0\n", out.string().c_str());
+    resuming = false;
+  }
   if (resuming) {
     std::ifstream in(ckpt_path, std::ios::binary);
-    if (!in) throw InputError(ckpt_path.string() + ": no checkpoint to resume from");
+    if (!in) throw InputError(ckpt_path.string() + ": cannot read the checkpoint");
     char magic[8];
     std::uint32_t version = 0;
     in.read(magic, 8);
@@ -127,20 +134,22 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   const double t_at_start = double(sim.time());
   const double frame_dt = 1.0 / os.fps;
 
+  auto write_checkpoint = [&] {
+    AtomicFile f(ckpt_path, true);
+    f.stream().write(kRunMagic, 8);
+    f.stream().write(reinterpret_cast<const char*>(&kRunCheckpointVersion), sizeof kRunCheckpointVersion);
+    f.stream().write(reinterpret_cast<const char*>(&loop.next_frame), sizeof loop.next_frame);
+    sim.save_state(f.stream());
+    f.commit();
+  };
   auto write_frame = [&] {
     Stopwatch sw;
     const double t = double(sim.time());
     if (formats.any()) frames.write(sim.particles(), loop.next_frame, t);
     if (opt.render) render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
     ++loop.next_frame;
-    if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0) {
-      AtomicFile f(ckpt_path, true);
-      f.stream().write(kRunMagic, 8);
-      f.stream().write(reinterpret_cast<const char*>(&kRunCheckpointVersion), sizeof kRunCheckpointVersion);
-      f.stream().write(reinterpret_cast<const char*>(&loop.next_frame), sizeof loop.next_frame);
-      sim.save_state(f.stream());
-      f.commit();
-    }
+    if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0)
+      write_checkpoint();
     output_ms += sw.ms();
   };
 
@@ -167,6 +176,12 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
                               std::to_string(sim.fluid_count()) + " fluid particles");
   }
   progress.finish();
+  // The end state too, so that a finished run can be extended with --resume DIR --until LATER.
+  if (os.checkpoint_every > 0) {
+    Stopwatch sw;
+    write_checkpoint();
+    output_ms += sw.ms();
+  }
 
   if (opt.render && !opt.quiet) {
     const auto v = make_mp4(png_dir, "frame_%05d.png", os.fps, out / "movie.mp4");

@@ -33,7 +33,7 @@ while IFS= read -r line; do
   cmd="$(echo "$cmd" | sed -E 's/--until ([0-9.]+)/--until 0.02/')"
   n=$((n + 1))
   echo "docs[$n]: $cmd"
-  if ! bash -c "$cmd" >"$scratch/out.txt" 2>&1; then
+  if ! bash -c "$cmd" </dev/null >"$scratch/out.txt" 2>&1; then
     echo "FAILED: $cmd"; tail -5 "$scratch/out.txt"; fail=$((fail + 1))
   fi
 done < <(awk '/^```/{inb=!inb; next} inb && /^(build\/release\/cellsph|build\/cellsph)/' "$root/README.md" "$root"/docs/*.md)
