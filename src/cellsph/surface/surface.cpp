@@ -31,13 +31,16 @@ SurfaceFormat parse_surface_format(std::string_view name) {
   throw InputError("surface format: expected \"ply\" or \"obj\", got \"" + std::string(name) + "\"");
 }
 
-std::string_view surface_format_extension(SurfaceFormat f) { return f == SurfaceFormat::Ply ? "ply" : "obj"; }
+std::string_view surface_format_extension(SurfaceFormat f) {
+  return f == SurfaceFormat::Ply ? "ply" : "obj";
+}
 
 void validate(const SurfaceOptions& opt) {
   auto bad = [](const char* key, double v, const char* what) {
     throw InputError(std::string("surface option ") + key + " = " + io::number_text(v) + ": " + what);
   };
-  if (!(std::isfinite(opt.voxel_size) && opt.voxel_size >= 0)) bad("voxel_size", opt.voxel_size, "must be >= 0");
+  if (!(std::isfinite(opt.voxel_size) && opt.voxel_size >= 0))
+    bad("voxel_size", opt.voxel_size, "must be >= 0");
   if (!(std::isfinite(opt.voxel_fraction) && opt.voxel_fraction > 0))
     bad("voxel_fraction", opt.voxel_fraction, "must be > 0");
   if (!(opt.iso > 0 && opt.iso < 1)) bad("iso", opt.iso, "must lie in (0, 1)");
@@ -78,9 +81,9 @@ template <int Dim, class Real>
 Prepared<Dim, Real> prepare(const Particles<Dim, Real>& p, const SurfaceOptions& opt) {
   validate(opt);
   const std::size_t n = p.size();
-  CELLSPH_CHECK(p.m.size() == n && p.rho.size() == n && p.h.size() == n && p.phase.size() == n &&
-                    p.kind.size() == n,
-                "particle fields of unequal length");
+  CELLSPH_CHECK(
+      p.m.size() == n && p.rho.size() == n && p.h.size() == n && p.phase.size() == n && p.kind.size() == n,
+      "particle fields of unequal length");
   Prepared<Dim, Real> out;
   double volume_sum = 0;
   double h_max = 0;
@@ -93,10 +96,10 @@ Prepared<Dim, Real> prepare(const Particles<Dim, Real>& p, const SurfaceOptions&
     bool finite = std::isfinite(m) && std::isfinite(rho) && std::isfinite(h);
     for (int k = 0; k < Dim; ++k) finite = finite && std::isfinite(static_cast<double>(p.x[i][k]));
     if (!finite || rho <= 0 || m <= 0 || h <= 0)
-      throw SimulationError("surface extraction: fluid particle " + std::to_string(i) +
-                            " has a non-finite position or a non-positive mass, density or support (m = " +
-                            io::number_text(m) + ", rho = " + io::number_text(rho) +
-                            ", h = " + io::number_text(h) + ")");
+      throw SimulationError(
+          "surface extraction: fluid particle " + std::to_string(i) +
+          " has a non-finite position or a non-positive mass, density or support (m = " + io::number_text(m) +
+          ", rho = " + io::number_text(rho) + ", h = " + io::number_text(h) + ")");
     volume_sum += m / rho;
     h_max = std::max(h_max, h);
     ++fluid;
@@ -113,10 +116,10 @@ Prepared<Dim, Real> prepare(const Particles<Dim, Real>& p, const SurfaceOptions&
     for (std::size_t i : idx)
       for (int k = 0; k < Dim; ++k)
         if (std::abs(static_cast<double>(p.x[i][k])) / out.voxel > kMaxIndex)
-          throw SimulationError("surface extraction: fluid particle " + std::to_string(i) + " at coordinate " +
-                                io::number_text(static_cast<double>(p.x[i][k])) +
-                                " m lies too far from the origin for voxels of " + io::number_text(out.voxel) +
-                                " m");
+          throw SimulationError("surface extraction: fluid particle " + std::to_string(i) +
+                                " at coordinate " + io::number_text(static_cast<double>(p.x[i][k])) +
+                                " m lies too far from the origin for voxels of " +
+                                io::number_text(out.voxel) + " m");
   return out;
 }
 
@@ -177,7 +180,8 @@ FloatGrid::Ptr colour_field(const Particles<Dim, Real>& p, const std::vector<std
 
 // Quads (OpenVDB's dual mesher) to triangles cut along the shorter diagonal, unreferenced points dropped,
 // and area-weighted vertex normals from the faces.
-SurfaceMesh to_triangle_mesh(const std::vector<openvdb::Vec3s>& pts, const std::vector<openvdb::Vec4I>& quads) {
+SurfaceMesh to_triangle_mesh(const std::vector<openvdb::Vec3s>& pts,
+                             const std::vector<openvdb::Vec4I>& quads) {
   SurfaceMesh mesh;
   constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> remap(pts.size(), kUnused);
@@ -221,10 +225,9 @@ SurfaceMesh to_triangle_mesh(const std::vector<openvdb::Vec3s>& pts, const std::
 SurfaceMesh mesh_phase(const FloatGrid& grid) {
   std::vector<openvdb::Vec3s> pts;
   std::vector<openvdb::Vec4I> quads;
+  // With phi < 0 inside, OpenVDB winds the quads counter-clockwise seen from outside (the tests check
+  // that the face normals point out of the fluid), the order PLY and OBJ readers expect.
   openvdb::tools::volumeToMesh(grid, pts, quads, 0.0);
-  // OpenVDB winds level-set quads clockwise seen from outside (negative inside); we want the usual
-  // counter-clockwise order, so that the face normals and the PLY/OBJ winding agree and point out.
-  for (auto& q : quads) std::swap(q[1], q[3]);
   return to_triangle_mesh(pts, quads);
 }
 
@@ -322,11 +325,10 @@ std::vector<std::filesystem::path> write_surfaces(const Particles<Dim, Real>& p,
   return paths;
 }
 
-#define CELLSPH_SURFACE_INSTANTIATE(D, R)                                                                     \
-  template std::vector<PhaseSurface> extract_surfaces<D, R>(const Particles<D, R>&, const SurfaceOptions&);   \
-  template std::vector<std::filesystem::path> write_surfaces<D, R>(const Particles<D, R>&,                     \
-                                                                   const SurfaceOptions&,                      \
-                                                                   const std::filesystem::path&, std::size_t);
+#define CELLSPH_SURFACE_INSTANTIATE(D, R)                                                                   \
+  template std::vector<PhaseSurface> extract_surfaces<D, R>(const Particles<D, R>&, const SurfaceOptions&); \
+  template std::vector<std::filesystem::path> write_surfaces<D, R>(                                         \
+      const Particles<D, R>&, const SurfaceOptions&, const std::filesystem::path&, std::size_t);
 CELLSPH_SURFACE_INSTANTIATE(2, float)
 CELLSPH_SURFACE_INSTANTIATE(2, double)
 CELLSPH_SURFACE_INSTANTIATE(3, float)

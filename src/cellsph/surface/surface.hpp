@@ -49,8 +49,8 @@ void validate(const SurfaceOptions& opt);
 // One extracted mesh, in world coordinates (z = 0 is the 2D plane). Triangles are counter-clockwise
 // seen from outside, and normals (unit, one per vertex) point out of the fluid.
 struct SurfaceMesh {
-  std::vector<float> points;          // x y z per vertex
-  std::vector<float> normals;         // nx ny nz per vertex
+  std::vector<float> points;             // x y z per vertex
+  std::vector<float> normals;            // nx ny nz per vertex
   std::vector<std::uint32_t> triangles;  // three vertex indices per triangle
   [[nodiscard]] std::size_t vertex_count() const { return points.size() / 3; }
   [[nodiscard]] std::size_t triangle_count() const { return triangles.size() / 3; }
