@@ -3,6 +3,8 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <filesystem>
+#include <string>
 
 #include "cellsph/surface/surface.hpp"
 
@@ -42,6 +44,20 @@ void BM_ExtractSurfaces(benchmark::State& state) {
 }
 BENCHMARK(BM_ExtractSurfaces<3>)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExtractSurfaces<2>)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+// The same plus writing the file (PLY binary or OBJ text) into the temporary folder.
+template <int Dim>
+void BM_WriteSurfaces(benchmark::State& state) {
+  const auto p = block<Dim>(static_cast<std::size_t>(state.range(0)));
+  SurfaceOptions opt;
+  opt.format = state.range(1) == 0 ? SurfaceFormat::Ply : SurfaceFormat::Obj;
+  const auto dir = std::filesystem::temp_directory_path() / "cellsph_surface_bench";
+  std::filesystem::create_directories(dir);
+  for (auto _ : state) benchmark::DoNotOptimize(write_surfaces(p, opt, dir, 0));
+  state.SetLabel(opt.format == SurfaceFormat::Ply ? "ply" : "obj");
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_WriteSurfaces<3>)->Args({100000, 0})->Args({100000, 1})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace cellsph

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -271,6 +272,56 @@ TEST(Surface, PlyAndObjCarryTheSameMeshAsExtracted) {
     EXPECT_EQ(m.v, ref.v);  // floats written as float bits or shortest round-trip text: exact
     EXPECT_EQ(m.n, ref.n);
     EXPECT_EQ(m.f, ref.f);
+  }
+}
+
+// The real consumers: VTK's own PLY and OBJ readers (ParaView's), through Debian's python3-vtk9 when
+// installed. VTK also says whether the mesh has open or non-manifold edges, and its volume.
+TEST(Surface, ReadBackByVtkWhenInstalled) {
+  if (std::system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-vtk9 is not installed; the parsers above still check the formats";
+  const auto p = ball<3, double>({0, 0, 0}, 0.08, [](const auto&) { return 0; });
+  const auto surfaces = extract_surfaces(p, {});
+  ASSERT_EQ(surfaces.size(), 1u);
+  const auto& mesh = surfaces[0].mesh;
+  test::TempDir dir("surface_vtk");
+  write_surface_mesh(mesh, SurfaceFormat::Ply, dir / "s.ply");
+  write_surface_mesh(mesh, SurfaceFormat::Obj, dir / "s.obj");
+  test::spit(
+      dir / "read.py",
+      "import sys, vtk\n"
+      "for name in sys.argv[1:]:\n"
+      "    r = vtk.vtkPLYReader() if name.endswith('.ply') else vtk.vtkOBJReader()\n"
+      "    r.SetFileName(name)\n"
+      "    r.Update()\n"
+      "    g = r.GetOutput()\n"
+      "    fe = vtk.vtkFeatureEdges()\n"
+      "    fe.SetInputData(g)\n"
+      "    fe.BoundaryEdgesOn(); fe.NonManifoldEdgesOn(); fe.FeatureEdgesOff(); fe.ManifoldEdgesOff()\n"
+      "    fe.Update()\n"
+      "    mp = vtk.vtkMassProperties()\n"
+      "    mp.SetInputData(g)\n"
+      "    mp.Update()\n"
+      "    n = g.GetPointData().GetNormals()\n"
+      "    print(g.GetNumberOfPoints(), g.GetNumberOfPolys(), n.GetNumberOfTuples() if n else -1,\n"
+      "          fe.GetOutput().GetNumberOfCells(), repr(mp.GetVolume()))\n");
+  const auto out = dir / "out.txt";
+  const std::string cmd = "/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "s.ply").string() +
+                          " " + (dir / "s.obj").string() + " > " + out.string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::slurp(out);
+  std::istringstream lines(test::slurp(out));
+  const double ours = enclosed_volume(from_surface(mesh));
+  for (const char* format : {"ply", "obj"}) {
+    std::size_t points = 0, polys = 0;
+    long normals = 0, open_edges = -1;
+    double volume = 0;
+    lines >> points >> polys >> normals >> open_edges >> volume;
+    ASSERT_FALSE(lines.fail()) << format << ": " << test::slurp(out);
+    EXPECT_EQ(points, mesh.vertex_count()) << format;
+    EXPECT_EQ(polys, mesh.triangle_count()) << format;
+    EXPECT_EQ(static_cast<std::size_t>(normals), mesh.vertex_count()) << format;
+    EXPECT_EQ(open_edges, 0) << format;
+    EXPECT_NEAR(volume / ours, 1.0, 1e-4) << format;
   }
 }
 
