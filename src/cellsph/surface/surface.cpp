@@ -15,6 +15,7 @@
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/task_arena.h>
 
 #include "cellsph/core/atomic_file.hpp"
 #include "cellsph/core/error.hpp"
@@ -48,6 +49,7 @@ void validate(const SurfaceOptions& opt) {
     bad("support_scale", opt.support_scale, "must be > 0");
   if (opt.slab_voxels < 1 || opt.slab_voxels % 2 == 0)
     bad("slab_voxels", opt.slab_voxels, "must be an odd number >= 1");
+  if (opt.threads < 0) bad("threads", opt.threads, "must be >= 0");
 }
 
 std::string surface_file_name(std::int32_t phase, std::size_t frame, SurfaceFormat format) {
@@ -307,10 +309,16 @@ std::vector<PhaseSurface> extract_surfaces(const Particles<Dim, Real>& p, const 
   std::vector<PhaseSurface> out;
   if (prep.phases.empty()) return out;
   initialize_openvdb();
-  for (const auto& [phase, idx] : prep.phases) {
-    const auto grid = colour_field(p, idx, prep.voxel, opt);
-    out.push_back({phase, mesh_phase(*grid)});
-  }
+  auto run = [&] {
+    for (const auto& [phase, idx] : prep.phases) {
+      const auto grid = colour_field(p, idx, prep.voxel, opt);
+      out.push_back({phase, mesh_phase(*grid)});
+    }
+  };
+  if (opt.threads > 0)
+    tbb::task_arena(opt.threads).execute(run);
+  else
+    run();
   return out;
 }
 

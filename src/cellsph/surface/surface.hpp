@@ -41,6 +41,9 @@ struct SurfaceOptions {
   // 2D runs: the contour is extruded into a closed slab this many voxels thick, centred on z = 0, so
   // the file is an ordinary closed triangle mesh that ParaView and Blender open.
   int slab_voxels = 3;
+  // Threads OpenVDB's mesher may use (it runs on TBB, not OpenMP); 0: TBB's default (every core).
+  // The result does not depend on it.
+  int threads = 0;
 };
 
 // Checks the options; throws InputError naming the option and its value.

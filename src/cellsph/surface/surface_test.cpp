@@ -411,6 +411,23 @@ TEST(Surface, SameInputGivesTheSameBytes) {
   for (int k = 0; k < 2; ++k) EXPECT_EQ(test::slurp(pa[k]), test::slurp(pb[k]));
 }
 
+// OpenVDB meshes with TBB threads: the mesh must not depend on how many.
+TEST(Surface, OneThreadOrTwoGiveTheSameMesh) {
+  const auto p = ball<3, double>({0.001, 0.002, 0.003}, 0.1, [](const auto& x) { return x[2] > 0 ? 1 : 0; });
+  SurfaceOptions o1, o2;
+  o1.threads = 1;
+  o2.threads = 2;
+  const auto one = extract_surfaces(p, o1);
+  const auto two = extract_surfaces(p, o2);
+  ASSERT_EQ(one.size(), 2u);
+  ASSERT_EQ(two.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(one[k].mesh.points, two[k].mesh.points);
+    EXPECT_EQ(one[k].mesh.normals, two[k].mesh.normals);
+    EXPECT_EQ(one[k].mesh.triangles, two[k].mesh.triangles);
+  }
+}
+
 TEST(Surface, OptionsChangeTheSurfaceAsDocumented) {
   const auto p = ball<3, double>({0, 0, 0}, 0.1, [](const auto&) { return 0; });
   SurfaceOptions coarse;
@@ -435,7 +452,7 @@ TEST(Surface, BadInputIsReportedWithTheValue) {
            [](SurfaceOptions& o) { o.iso = 1.0; }, [](SurfaceOptions& o) { o.iso = 0.0; },
            [](SurfaceOptions& o) { o.voxel_size = -1; }, [](SurfaceOptions& o) { o.voxel_fraction = 0; },
            [](SurfaceOptions& o) { o.support_scale = std::nan(""); },
-           [](SurfaceOptions& o) { o.slab_voxels = 2; }}) {
+           [](SurfaceOptions& o) { o.slab_voxels = 2; }, [](SurfaceOptions& o) { o.threads = -1; }}) {
     SurfaceOptions o;
     set(o);
     EXPECT_THROW(validate(o), InputError);
