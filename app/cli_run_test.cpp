@@ -192,12 +192,29 @@ TEST(CliRun, RenderWritesOnePngPerFrame) {
     EXPECT_TRUE(fs::exists(dir / "out" / "png" / ("frame_0000" + std::to_string(f) + ".png"))) << f;
 }
 
+TEST(CliRun, SurfaceWritesOneMeshPerFrameAndPhase) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  const auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "out") +
+                                  " --quiet --format csv --surface --surface-format obj --until 0.04");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int f = 0; f <= 2; ++f) {
+    const auto mesh = read_file(dir / "out" / "surface" / ("surface_0_0000" + std::to_string(f) + ".obj"));
+    EXPECT_NE(mesh.find("\nv "), std::string::npos) << "frame " << f << " has no vertices";
+    EXPECT_NE(mesh.find("\nf "), std::string::npos) << "frame " << f << " has no faces";
+  }
+  const auto bad = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "bad") + " --surface-format stl");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("stl"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad")) << "a bad option must not leave an output folder behind";
+}
+
 TEST(CliRun, HelpDocumentsEveryOption) {
   TempDir dir;
   const auto r = run_cli(dir, "run --help");
   EXPECT_EQ(r.code, 0);
   for (const char* opt : {"--out", "--threads", "--method", "--until", "--steps", "--fps", "--format", "--render",
-                          "--color-by", "--quiet", "--resume", "default"})
+                          "--color-by", "--surface", "--surface-format", "--quiet", "--resume", "default"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt << " missing from --help:\n" << r.out;
 }
 

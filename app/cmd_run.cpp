@@ -24,6 +24,7 @@
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"
+#include "cellsph/surface/surface.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
 
@@ -47,6 +48,8 @@ struct RunOptions {
   std::string formats;
   bool render = false;
   std::string color_by;
+  bool surface = false;
+  std::string surface_format = "ply";
   bool quiet = false;
   std::string resume;
 };
@@ -126,6 +129,12 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   rbox.hi = scene.view_hi;
   const auto png_dir = out / "png";
   if (opt.render) std::filesystem::create_directories(png_dir);
+  SurfaceOptions sopt;
+  sopt.format = parse_surface_format(opt.surface_format);
+  sopt.threads = max_threads();
+  validate(sopt);
+  const auto surface_dir = out / "surface";
+  if (opt.surface) std::filesystem::create_directories(surface_dir);
 
   Progress progress(opt.quiet);
   Stopwatch wall;
@@ -147,6 +156,7 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     const double t = double(sim.time());
     if (formats.any()) frames.write(sim.particles(), loop.next_frame, t);
     if (opt.render) render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
+    if (opt.surface) write_surfaces(sim.particles(), sopt, surface_dir, loop.next_frame);
     ++loop.next_frame;
     if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0)
       write_checkpoint();
@@ -228,6 +238,8 @@ int run_command(RunOptions opt) {
       if (opt.steps < 0) opt.steps = o.at("steps").get<long>();
       if (!opt.render) opt.render = o.at("render").get<bool>();
       if (opt.color_by.empty()) opt.color_by = o.at("color_by").get<std::string>();
+      if (!opt.surface) opt.surface = o.at("surface").get<bool>();
+      if (o.contains("surface_format")) opt.surface_format = o.at("surface_format").get<std::string>();
     } catch (const nlohmann::json::exception& e) {
       throw InputError(run_file.string() + ": damaged (" + e.what() + ")");
     }
@@ -239,6 +251,13 @@ int run_command(RunOptions opt) {
   const SceneHeader header = read_scene_header(scene_json, source);
   if (out.empty()) out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
 
+  // Option errors come before anything is written.
+  parse_surface_format(opt.surface_format);
+  if (!opt.method.empty() && !parse_method(opt.method))
+    throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() + ")");
+  if (!opt.formats.empty()) parse_output_formats(opt.formats, "--format");
+  if (!opt.color_by.empty()) parse_color_by(opt.color_by, "--color-by");
+
   ScopedThreads threads(opt.threads);
   if (!resuming) {
     std::filesystem::create_directories(out);
@@ -247,7 +266,8 @@ int run_command(RunOptions opt) {
     saved["source"] = source;
     saved["options"] = {{"method", opt.method}, {"fps", opt.fps},   {"formats", opt.formats},
                         {"until", opt.until},   {"steps", opt.steps}, {"render", opt.render},
-                        {"color_by", opt.color_by}};
+                        {"color_by", opt.color_by}, {"surface", opt.surface},
+                        {"surface_format", opt.surface_format}};
     write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
   }
   if (header.dim == 2)
@@ -277,6 +297,9 @@ void register_run(CLI::App& app, int& result) {
   sub->add_option("--format", opt->formats, "Frame formats, any of vtu,ply,csv (default: the scene's output.formats)");
   sub->add_flag("--render", opt->render, "Also write a PNG picture per frame (and an MP4 if ffmpeg is installed)");
   sub->add_option("--color-by", opt->color_by, "Picture colours: phase, speed or pressure (default: the scene's)");
+  sub->add_flag("--surface", opt->surface,
+                "Also write the fluid surface per frame and phase (surface/surface_PHASE_NNNNN.ply), see docs/surfaces.md");
+  sub->add_option("--surface-format", opt->surface_format, "Surface mesh format: ply or obj (default: ply)");
   sub->add_flag("--quiet", opt->quiet, "No progress line and no summary");
   sub->add_option("--resume", opt->resume, "Continue the run in this output folder from its last checkpoint");
   sub->callback([opt, &result] { result = run_command(*opt); });
