@@ -75,7 +75,7 @@ TEST(Scene, BlockIsFilledAtLatticeCentresWithPhaseMass) {
   EXPECT_DOUBLE_EQ(s.particles.x[0][0], 0.05);
   EXPECT_DOUBLE_EQ(s.particles.x[0][1], 0.05);
   EXPECT_NEAR(s.solver.phases[0].mass, 1000 * 0.1 * 0.1, 1e-12);  // rest density x spacing^2
-  EXPECT_NEAR(s.solver.support, 0.2, 1e-15);                        // default: 2 spacings
+  EXPECT_NEAR(s.solver.support, 0.2, 1e-15);                      // default: 2 spacings
   EXPECT_TRUE(s.solver.box.enabled);
 }
 
@@ -122,7 +122,8 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"/fluids/0/phase", "3", "/fluids/0/phase", "out of range"},
                       BadCase{"/fluids/0/phase", "\"oil\"", "/fluids/0/phase", "oil"},
                       BadCase{"/fluids/0/max", "[3, 0.5]", "/fluids/0", "outside the boundary box"},
-                      BadCase{"/solver/support", "0.05", "/solver/support", "smaller than the particle spacing"},
+                      BadCase{"/solver/support", "0.05", "/solver/support",
+                              "smaller than the particle spacing"},
                       BadCase{"/solver/model", "\"pbf\"", "/solver/model", "pbf"},
                       BadCase{"/solver/eos/kind", "\"ideal\"", "/solver/eos/kind", "ideal"},
                       BadCase{"/solver/gravity", "[0, \"down\"]", "/solver/gravity", "down"},
@@ -141,9 +142,7 @@ TEST(Scene, MissingFileIsAnInputError) {
 
 TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
   const auto path = std::filesystem::temp_directory_path() / "cellsph_scene_syntax.json";
-  {
-    std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 0.1,,\n}\n";
-  }
+  { std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 0.1,,\n}\n"; }
   std::string src;
   try {
     read_scene_json(path.string(), src);

@@ -129,7 +129,7 @@ void check_inside(const Simulation<Dim, Real>& sim, const nlohmann::json& j, con
       hi[a] = r["max"][a].get<double>();
     }
     if (walls && b["walls"].value("open_top", true)) hi[1] = 1e300;  // every scene has y up
-  } else if (j.contains("domain")) {  // free droplet: its domain
+  } else if (j.contains("domain")) {                                 // free droplet: its domain
     for (int a = 0; a < Dim; ++a) {
       lo[a] = j["domain"]["min"][a].get<double>();
       hi[a] = j["domain"]["max"][a].get<double>();
@@ -194,7 +194,8 @@ void run_scene(const nlohmann::json& j, const std::string& name) {
     }
     const double e = energy(sim);
     emax = std::max(emax, e);
-    ASSERT_LE(e, e0 + tol) << name << ": step " << s << ": energy " << e << " > initial " << e0 << " + " << tol;
+    ASSERT_LE(e, e0 + tol) << name << ": step " << s << ": energy " << e << " > initial " << e0 << " + "
+                           << tol;
     if (s % 50 == 0 || s == kSteps - 1) {
       check_inside(sim, j, name, s);
       if (::testing::Test::HasFatalFailure()) return;

@@ -69,7 +69,8 @@ TEST(TwoPhaseComparison, NumberDensityBeatsEq7AtTheInterface) {
     const auto number = run(drop, "number");
     std::cout << "[two-phase] " << (drop ? "(b) heavy disc in light fluid" : "(a) heavy over light")
               << ": worst density error eq. 7 " << 100 * mass.density << "%, number " << 100 * number.density
-              << "%; largest spurious speed eq. 7 " << mass.speed << " m/s, number " << number.speed << " m/s\n";
+              << "%; largest spurious speed eq. 7 " << mass.speed << " m/s, number " << number.speed
+              << " m/s\n";
     EXPECT_LT(number.density, mass.density);
     EXPECT_LT(number.speed, mass.speed);
   }
