@@ -270,8 +270,12 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
       wr.finish();
       const Real weight =
           volume ? cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim)) : Real(0);
+      // The open face is the top as gravity sees it (scenes with y up in 3D), not always the last axis.
+      int up = Dim - 1;
+      for (int a = 0; a < Dim; ++a)
+        if (std::abs(cfg.gravity[a]) > std::abs(cfg.gravity[up])) up = a;
       add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
-                    open_top, 0, weight);
+                    open_top, 0, weight, up);
       container = b;
     }
     if (br.has("obstacles")) {

@@ -48,6 +48,25 @@ TEST(Scene, EveryBuiltinSceneLoads) {
   }
 }
 
+// A 3D tank with gravity along -y: open_top must open the y face and keep the z faces closed (it once
+// opened the z-max face, so the 3D dam break drained through its front wall).
+TEST(Scene, OpenTopWallsOpenTheFaceGravityPointsAwayFrom) {
+  const auto j = nlohmann::json::parse(R"({
+    "dimension": 3, "spacing": 0.1, "solver": {"gravity": [0, -9.81, 0]},
+    "fluids": [{"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]}],
+    "boundary": {"walls": {"min": [0, 0, 0], "max": [1, 1, 1], "layers": 1, "open_top": true}}
+  })");
+  const auto s = load_scene<3, double>(j, "scene.json");
+  int above_y = 0, beyond_z = 0;
+  for (std::size_t i = 0; i < s.particles.size(); ++i) {
+    if (s.particles.kind[i] == 0) continue;
+    above_y += s.particles.x[i][1] > 1 ? 1 : 0;
+    beyond_z += s.particles.x[i][2] > 1 ? 1 : 0;
+  }
+  EXPECT_EQ(above_y, 0);
+  EXPECT_EQ(beyond_z, 12 * 11);  // the z = 1.05 face: x in -0.05..1.05 (12), y in -0.05..0.95 (11)
+}
+
 TEST(Scene, BlockIsFilledAtLatticeCentresWithPhaseMass) {
   const auto j = nlohmann::json::parse(kMinimal);
   const auto s = load_scene<2, double>(j, "scene.json");
@@ -56,7 +75,7 @@ TEST(Scene, BlockIsFilledAtLatticeCentresWithPhaseMass) {
   EXPECT_DOUBLE_EQ(s.particles.x[0][0], 0.05);
   EXPECT_DOUBLE_EQ(s.particles.x[0][1], 0.05);
   EXPECT_NEAR(s.solver.phases[0].mass, 1000 * 0.1 * 0.1, 1e-12);  // rest density x spacing^2
-  EXPECT_NEAR(s.solver.support, 0.2, 1e-15);                        // default: 2 spacings
+  EXPECT_NEAR(s.solver.support, 0.2, 1e-15);                      // default: 2 spacings
   EXPECT_TRUE(s.solver.box.enabled);
 }
 
@@ -103,7 +122,8 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"/fluids/0/phase", "3", "/fluids/0/phase", "out of range"},
                       BadCase{"/fluids/0/phase", "\"oil\"", "/fluids/0/phase", "oil"},
                       BadCase{"/fluids/0/max", "[3, 0.5]", "/fluids/0", "outside the boundary box"},
-                      BadCase{"/solver/support", "0.05", "/solver/support", "smaller than the particle spacing"},
+                      BadCase{"/solver/support", "0.05", "/solver/support",
+                              "smaller than the particle spacing"},
                       BadCase{"/solver/model", "\"pbf\"", "/solver/model", "pbf"},
                       BadCase{"/solver/eos/kind", "\"ideal\"", "/solver/eos/kind", "ideal"},
                       BadCase{"/solver/gravity", "[0, \"down\"]", "/solver/gravity", "down"},
@@ -122,9 +142,7 @@ TEST(Scene, MissingFileIsAnInputError) {
 
 TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
   const auto path = std::filesystem::temp_directory_path() / "cellsph_scene_syntax.json";
-  {
-    std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 0.1,,\n}\n";
-  }
+  { std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 0.1,,\n}\n"; }
   std::string src;
   try {
     read_scene_json(path.string(), src);

@@ -46,8 +46,10 @@ std::size_t add_block(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const V
 // weight 0 lets the Simulation compute Akinci's psi_b; rho0 spacing^Dim makes a wall at least one support
 // length thick behave like resting fluid.
 template <int Dim, class Real>
+// `up`: the axis whose upper face open_top leaves open (the one gravity points against).
 std::size_t add_box_walls(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi,
-                          Real spacing, int layers, bool open_top, std::int32_t phase = 0, Real weight = 0) {
+                          Real spacing, int layers, bool open_top, std::int32_t phase = 0, Real weight = 0,
+                          int up = Dim - 1) {
   int n[3] = {1, 1, 1};
   for (int a = 0; a < Dim; ++a) n[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / spacing));
   const int L = layers;
@@ -60,7 +62,7 @@ std::size_t add_box_walls(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, con
         bool wall = false;
         for (int a = 0; a < Dim; ++a) wall = wall || idx[a] < 0 || idx[a] >= n[a];
         if (!wall) continue;
-        if (open_top && idx[Dim - 1] >= n[Dim - 1]) continue;
+        if (open_top && idx[up] >= n[up]) continue;
         Vec<Dim, Real> x;
         for (int a = 0; a < Dim; ++a) x[a] = lo[a] + (Real(idx[a]) + Real(0.5)) * spacing;
         add_particle(p, x, phase, ParticleKind::Boundary, weight);

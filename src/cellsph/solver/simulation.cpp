@@ -148,12 +148,14 @@ void Simulation<Dim, Real>::compute_density_pressure() {
       Real rho = 0;
       if (number) {
         // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
-        // is not given the heavy one's density.
+        // is not given the heavy one's density. A wall particle of volume V_b = psi_b / rho0_b counts as
+        // V_b / V_i fluid particles (V_i = m_i / rho0_i), so that with one phase this is eq. 7 exactly.
         Real delta = w.W2(0);
+        const Real inv_vol_i = rho0_[i] / p_.m[i];
         for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
           const std::uint32_t j = *it;
           const Real wij = w.W2(distance2(xi, p_.x[j]));
-          delta += p_.kind[j] == kFluid ? wij : wij * p_.m[j] / rho0_[i];
+          delta += p_.kind[j] == kFluid ? wij : wij * (p_.m[j] / rho0_[j]) * inv_vol_i;
         }
         rho = p_.m[i] * delta;
       } else {

@@ -497,6 +497,35 @@ TEST(TwoPhase, NumberDensityKeepsTheDensityJumpSharp) {
   EXPECT_LT(number, 0.01);
 }
 
+// One phase at rest in a tank of boundary particles: the number density m_i sum_j W_ij V_j / V_i must equal
+// eq. 7's sum_j m_j W_ij, wall particles included (same mass, same rest density: the two formulations are the
+// same sum). Reference: eq. 7 evaluated by the same solver with density "mass". The wall term once counted
+// a wall particle by its volume V_b instead of V_b / V_i, so fluid next to a wall had ~half its density and
+// the two-phase tank blew up in a few steps.
+TEST(TwoPhase, NumberDensityEqualsMassDensityForOnePhaseWithWalls) {
+  const double s = 0.02;
+  std::vector<double> rho[2];
+  for (int k = 0; k < 2; ++k) {
+    auto cfg = base_config(Model::PaperMultiphase);
+    cfg.density = k == 0 ? DensityFormulation::Mass : DensityFormulation::Number;
+    cfg.density_kernel = KernelKind::CubicSpline;
+    cfg.support = 2 * s;
+    cfg.phases[0].mass = 1000 * s * s;
+    cfg.time.dt = 1e-6;
+    Particles<2, double> p;
+    add_block<2, double>(p, V2{{0, 0}}, V2{{0.2, 0.2}}, s, 0);
+    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{0.2, 0.3}}, s, 2, true, 0, 1000 * s * s);
+    ScopedThreads one(1);
+    Simulation<2, double> sim(cfg, p);
+    sim.step();
+    const auto& q = sim.particles();
+    for (std::size_t i = 0; i < q.size(); ++i)
+      if (q.kind[i] == 0) rho[k].push_back(q.rho[i]);
+  }
+  ASSERT_EQ(rho[0].size(), rho[1].size());
+  for (std::size_t i = 0; i < rho[0].size(); ++i) ASSERT_NEAR(rho[1][i], rho[0][i], 1e-9 * rho[0][i]) << i;
+}
+
 // The paper's walls in a run: a blob dropped into a box of four planes (inelastic collision, wet friction,
 // projection) never ends a step outside, and its energy falls (collisions and friction only remove it).
 TEST(Walls, PaperPlanesHoldAFallingBlob) {
