@@ -72,7 +72,11 @@ class Simulation {
   static constexpr std::uint32_t kStateVersion = 2;  // 2: the per-particle "tick" field
 
  private:
-  void compute_neighbors();
+  // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
+  // fluid rows, so boundary particles are then searched with support 0.
+  void compute_neighbors(bool boundary_rows = false);
+  template <class F>
+  void for_fluid(F&& f) const;
   void compute_density_pressure();
   void compute_forces_paper();
   void compute_normals();
@@ -93,8 +97,14 @@ class Simulation {
   std::vector<V> normal_;          // CSF: colour gradient n_i of the current step
   std::vector<V> f_pressure_;      // WCSPH: pressure force, applied after the predicted velocity
   std::vector<Real> rho0_;         // rest density per particle (from its phase)
+  // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair
+  // (the same expressions as before, so the values are bit for bit those computed per pair).
+  std::vector<Real> vol_;    // V_j = m_j / rho_j
+  std::vector<Real> prho2_;  // p_j / rho_j^2 (WCSPH symmetric pressure)
   std::vector<V> xs_;              // per-particle steps: every position extrapolated to the global clock
   std::vector<std::uint8_t> due_;  // per-particle steps: 1 for the particles integrated this step
+  std::vector<std::uint32_t> fluid_;  // indices of the fluid particles, ascending (kinds never change)
+  std::vector<Real> search_h_;        // support per particle for the step's search (0 for boundary)
   bool any_tension_ = false;
   std::size_t fluid_count_ = 0;
 
