@@ -114,12 +114,15 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   init_boundary_weights();
   fluid_.clear();
   fluid_.reserve(fluid_count_);
+  // 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
+  skin_ = Real(0.15) * cfg_.support;
   search_h_.assign(n, Real(0));
   for (std::size_t i = 0; i < n; ++i) {
     if (p_.kind[i] != kFluid) continue;
     fluid_.push_back(static_cast<std::uint32_t>(i));
-    search_h_[i] = p_.h[i];
+    search_h_[i] = p_.h[i] + skin_;
   }
+  lists_valid_ = false;
 }
 
 // f(i) for every fluid particle, split statically over the fluid particles alone: boundary particles
@@ -152,9 +155,27 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   // Boundary rows are never read by a step (j is a neighbour of i iff |x_i - x_j| <= h_i, so fluid rows
   // do not depend on the boundary's support).
-  const bool all = boundary_rows || fluid_count_ == p_.size() || search_h_.size() != p_.size();
-  search_.build(std::span<const V>(p_.x), std::span<const Real>(all ? p_.h : search_h_));
+  if (boundary_rows || search_h_.size() != p_.size()) {
+    search_.build(std::span<const V>(p_.x), std::span<const Real>(p_.h));
+    search_.find_all(nl_);
+    lists_valid_ = false;
+    return;
+  }
+  if (lists_valid_) {
+    Real d2 = 0;  // largest squared displacement since the lists were built (order-free: a maximum)
+    const auto count = static_cast<std::int64_t>(fluid_.size());
+#pragma omp parallel for schedule(static) reduction(max : d2)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const std::size_t i = fluid_[static_cast<std::size_t>(k)];
+      d2 = std::max(d2, distance2(p_.x[i], x_built_[i]));
+    }
+    const Real limit = Real(0.45) * skin_;
+    if (d2 <= limit * limit) return;
+  }
+  search_.build(std::span<const V>(p_.x), std::span<const Real>(search_h_));
   search_.find_all(nl_);
+  x_built_ = p_.x;
+  lists_valid_ = true;
 }
 
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
@@ -166,6 +187,7 @@ void Simulation<Dim, Real>::compute_density_pressure() {
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
     for_fluid([&](std::size_t i) {
       const V xi = p_.x[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
       Real rho = 0;
       if (number) {
         // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
@@ -173,14 +195,19 @@ void Simulation<Dim, Real>::compute_density_pressure() {
         Real delta = w.W2(0);
         for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
           const std::uint32_t j = *it;
-          const Real wij = w.W2(distance2(xi, p_.x[j]));
+          const Real r2 = distance2(xi, p_.x[j]);
+          if (r2 > hi2) continue;  // in the Verlet skin only
+          const Real wij = w.W2(r2);
           delta += p_.kind[j] == kFluid ? wij : wij * p_.m[j] / rho0_[i];
         }
         rho = p_.m[i] * delta;
       } else {
         rho = density_term(w, p_.m[i], Real(0));
-        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it)
-          rho += density_term(w, p_.m[*it], distance2(xi, p_.x[*it]));
+        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+          const Real r2 = distance2(xi, p_.x[*it]);
+          if (r2 > hi2) continue;  // in the Verlet skin only
+          rho += density_term(w, p_.m[*it], r2);
+        }
       }
       p_.rho[i] = rho;
       const Real pres = cfg_.eos.pressure(rho, rho0_[i]);
@@ -199,9 +226,10 @@ void Simulation<Dim, Real>::compute_normals() {
   normal_.assign(p_.size(), V{});
   for_fluid([&](std::size_t i) {
     V n{};
+    const Real hi2 = p_.h[i] * p_.h[i];
     for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
       const std::uint32_t j = *it;
-      if (p_.kind[j] != kFluid) continue;
+      if (p_.kind[j] != kFluid || distance2(p_.x[i], p_.x[j]) > hi2) continue;
       n += wc.gradW(p_.x[i] - p_.x[j]) * (p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
     }
     normal_[i] = n;
@@ -231,6 +259,7 @@ void Simulation<Dim, Real>::compute_forces_paper() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
       const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
       const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
       Real kappa = 0;  // CSF: -div(n / |n|) over neighbours with a defined normal
@@ -238,6 +267,7 @@ void Simulation<Dim, Real>::compute_forces_paper() {
       for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
+        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
           // averaged_pressure_force and averaged_viscosity_force (eq. 8a, 8b), inlined with the
@@ -300,11 +330,13 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
       const V vel_i = p_.v[i];
       const Real prho2_i = prho2_[i];
       for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
+        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
           // monaghan_viscosity_force and symmetric_pressure_force, inlined with one kernel gradient
@@ -709,9 +741,10 @@ void Simulation<Dim, Real>::load_state(std::istream& in) {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
     const bool fluid = p_.kind[i] == kFluid;
     if (fluid) fluid_.push_back(static_cast<std::uint32_t>(i));
-    search_h_[i] = fluid ? p_.h[i] : Real(0);
+    search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
   }
   fluid_count_ = fluid_.size();
+  lists_valid_ = false;
   time_ = t;
   last_dt_ = ldt;
   steps_ = st;

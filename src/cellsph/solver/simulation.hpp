@@ -104,7 +104,16 @@ class Simulation {
   std::vector<V> xs_;              // per-particle steps: every position extrapolated to the global clock
   std::vector<std::uint8_t> due_;  // per-particle steps: 1 for the particles integrated this step
   std::vector<std::uint32_t> fluid_;  // indices of the fluid particles, ascending (kinds never change)
-  std::vector<Real> search_h_;        // support per particle for the step's search (0 for boundary)
+  // Verlet lists: the step's CSR lists hold the pairs within h + skin of the positions x_built_ and are
+  // kept while no particle has moved more than 0.45 skin since (then every pair within h now was
+  // within h + skin then: triangle inequality). Every pair loop skips pairs with
+  // distance2(x_i, x_j) > h_i^2, the search's own test, so each sum runs over exactly the neighbours
+  // an exact search gives, in the same (ascending) order: results do not depend on the skin, the
+  // rebuild schedule, the method or a resume.
+  std::vector<Real> search_h_;        // support per particle for the lists: h + skin (0 for boundary)
+  std::vector<V> x_built_;            // positions the lists were built from
+  Real skin_ = 0;
+  bool lists_valid_ = false;
   bool any_tension_ = false;
   std::size_t fluid_count_ = 0;
 
