@@ -176,6 +176,7 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   search_.find_all(nl_);
   x_built_ = p_.x;
   lists_valid_ = true;
+  ++timings_.list_builds;
 }
 
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.

@@ -26,6 +26,7 @@ struct StepTimings {
   double neighbors = 0;    // building the search structure and the CSR lists
   double forces = 0;       // density, pressure, forces
   double integration = 0;  // time step choice, integration, walls, stability check
+  std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
 };
 
 template <int Dim, class Real>
