@@ -13,13 +13,13 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
-#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -293,7 +293,6 @@ void run_bench_neighbors(const BenchArgs& a) {
     bench_neighbors<3>(a, methods, sizes, radii, sets);
 }
 
-
 // ---- cellsph bench sph -----------------------------------------------------------------------------
 struct SphArgs {
   std::string sizes = "100000,1000000";
@@ -378,7 +377,8 @@ void run_bench_sph(const SphArgs& a) {
   auto sizes = parse_list<std::size_t>("--sizes", a.sizes, 1);
   const auto models = split(a.models);
   for (const auto& m : models)
-    if (m != "wcsph" && m != "paper") throw InputError("--models: unknown model '" + m + "' (expected wcsph,paper)");
+    if (m != "wcsph" && m != "paper")
+      throw InputError("--models: unknown model '" + m + "' (expected wcsph,paper)");
   const auto precisions = split(a.precisions);
   for (const auto& p : precisions)
     if (p != "float" && p != "double")
@@ -396,14 +396,15 @@ void run_bench_sph(const SphArgs& a) {
 
   std::printf("cellsph bench sph: %d thread(s), %d warm-up step(s), then the mean of %d step(s)\n",
               max_threads(), warmup, steps);
-  std::printf("  search = NeighborSearch build + find_all (Verlet lists: only when a particle has moved\n"
-              "  0.45 skin; builds = searches run in the timed steps) + the displacement check; dynamics =\n"
-              "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
-              "  nbr%% = search / step.\n");
+  std::printf(
+      "  search = NeighborSearch build + find_all (Verlet lists: only when a particle has moved\n"
+      "  0.45 skin; builds = searches run in the timed steps) + the displacement check; dynamics =\n"
+      "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
+      "  nbr%% = search / step.\n");
 
   std::printf("\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double) ==\n");
-  std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms",
-              "dynamics ms", "step ms", "nbr%", "builds", "pairs");
+  std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
+              "step ms", "nbr%", "builds", "pairs");
   for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
     std::string source;
     const nlohmann::json base = read_scene_json(name, source);
@@ -423,8 +424,9 @@ void run_bench_sph(const SphArgs& a) {
   std::string source;
   const nlohmann::json base = read_scene_json("dam-break-3d", source);
   const double volume = fluid_volume(base, source);
-  std::printf("\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
-              "support 2 s, walls kept), Cell Indexing ==\n");
+  std::printf(
+      "\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
+      "support 2 s, walls kept), Cell Indexing ==\n");
   std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s\n", "model", "real", "fluid", "total",
               "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s");
   for (std::size_t n : sizes) {
@@ -478,7 +480,8 @@ void register_bench(CLI::App& app, int& result) {
   });
 
   auto sargs = std::make_shared<SphArgs>();
-  auto* sph = sub->add_subcommand("sph", "SPH step: Table 1 split (search / dynamics) and 3D particle-steps/s");
+  auto* sph =
+      sub->add_subcommand("sph", "SPH step: Table 1 split (search / dynamics) and 3D particle-steps/s");
   sph->add_option("--sizes", sargs->sizes, "comma-separated fluid particle counts of the 3D dam break")
       ->capture_default_str();
   sph->add_option("--steps", sargs->steps, "timed steps per case")->capture_default_str();

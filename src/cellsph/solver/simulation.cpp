@@ -317,8 +317,8 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
   const Real lap_self = wc.laplacian(0);
   const Real h = cfg_.support;
-  const Real eps2 = Real(0.01) * h * h;           // Monaghan's r^2 regulariser
-  const Real visc_c = Real(2 * (Dim + 2));         // 2 (d + 2)
+  const Real eps2 = Real(0.01) * h * h;     // Monaghan's r^2 regulariser
+  const Real visc_c = Real(2 * (Dim + 2));  // 2 (d + 2)
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wg) {
     for_fluid([&](std::size_t i) {
       const Real vol_i = p_.m[i] / p_.rho[i];
