@@ -5,10 +5,15 @@
 // (the cost of a method's over-approximation), and memory: the bytes the search reports holding,
 // the neighbour lists' own size, and the growth of the process's peak resident set during
 // build + find_all, measured by the kernel (VmHWM after resetting it through /proc/self/clear_refs).
+//
+// `cellsph bench sph` times Simulation::step(): Table 1's split into neighbour search and dynamics for
+// the paper's 1600-particle dam breaks with every method, and fluid particle-steps per second for the
+// 3D dam break rescaled to 10^5 and 10^6 fluid particles.
 #include <malloc.h>
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -23,8 +28,11 @@
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
+#include "cellsph/core/timer.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
 #include "cellsph/neighbors/point_sets.hpp"
+#include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/simulation.hpp"
 #include "commands.hpp"
 
 namespace cellsph::app {
@@ -285,6 +293,165 @@ void run_bench_neighbors(const BenchArgs& a) {
     bench_neighbors<3>(a, methods, sizes, radii, sets);
 }
 
+// ---- cellsph bench sph -----------------------------------------------------------------------------
+struct SphArgs {
+  std::string sizes = "100000,1000000";
+  std::string methods;
+  std::string models = "wcsph,paper";
+  std::string precisions = "float,double";
+  int steps = 20;
+  int warmup = 3;
+  int threads = 2;
+  bool quick = false;
+};
+
+struct StepFigures {
+  std::size_t fluid = 0, total = 0;
+  int steps = 0;
+  double neighbors_ms = 0, dynamics_ms = 0;  // per step
+  double wall_ms = 0;                        // per step, around step()
+  std::uint64_t pairs = 0;                   // neighbour pairs of the last search
+  std::uint64_t builds = 0;                  // neighbour searches during the timed steps
+};
+
+template <int Dim, class Real>
+StepFigures time_steps(const nlohmann::json& j, const std::string& source, int warmup, int steps) {
+  Scene<Dim, Real> scene = load_scene<Dim, Real>(j, source);
+  Simulation<Dim, Real> sim(scene.solver, std::move(scene.particles));
+  for (int s = 0; s < warmup; ++s) sim.step();
+  const StepTimings t0 = sim.timings();
+  Stopwatch sw;
+  for (int s = 0; s < steps; ++s) sim.step();
+  const double wall = sw.ms();
+  const StepTimings& t1 = sim.timings();
+  StepFigures f;
+  f.fluid = sim.fluid_count();
+  f.total = sim.particles().size();
+  f.steps = steps;
+  f.neighbors_ms = (t1.neighbors - t0.neighbors) / steps;
+  f.dynamics_ms = (t1.forces - t0.forces + t1.integration - t0.integration) / steps;
+  f.wall_ms = wall / steps;
+  f.pairs = sim.search_stats().pairs;
+  f.builds = t1.list_builds - t0.list_builds;
+  return f;
+}
+
+StepFigures time_scene(const nlohmann::json& j, const std::string& source, int warmup, int steps) {
+  const SceneHeader h = read_scene_header(j, source);
+  if (h.dim == 2)
+    return h.single_precision ? time_steps<2, float>(j, source, warmup, steps)
+                              : time_steps<2, double>(j, source, warmup, steps);
+  return h.single_precision ? time_steps<3, float>(j, source, warmup, steps)
+                            : time_steps<3, double>(j, source, warmup, steps);
+}
+
+std::vector<Method> parse_methods(const std::string& text) {
+  std::vector<Method> methods;
+  if (text.empty()) return {std::begin(kAllMethods), std::end(kAllMethods)};
+  for (const auto& name : split(text)) {
+    const auto m = parse_method(name);
+    if (!m)
+      throw InputError("--methods: unknown method '" + name + "' (expected a comma-separated list of " +
+                       method_names_joined(",") + ")");
+    methods.push_back(*m);
+  }
+  return methods;
+}
+
+// Total volume of the scene's fluid blocks (they do not overlap in the built-in scenes).
+double fluid_volume(const nlohmann::json& j, const std::string& source) {
+  double v = 0;
+  for (const auto& b : j.at("fluids")) {
+    double e = 1;
+    const auto& lo = b.at("min");
+    const auto& hi = b.at("max");
+    for (std::size_t a = 0; a < lo.size(); ++a) e *= hi.at(a).get<double>() - lo.at(a).get<double>();
+    v += e;
+  }
+  if (!(v > 0)) throw InputError(source + ": /fluids: no fluid volume to rescale");
+  return v;
+}
+
+void run_bench_sph(const SphArgs& a) {
+  const auto methods = parse_methods(a.methods);
+  auto sizes = parse_list<std::size_t>("--sizes", a.sizes, 1);
+  const auto models = split(a.models);
+  for (const auto& m : models)
+    if (m != "wcsph" && m != "paper")
+      throw InputError("--models: unknown model '" + m + "' (expected wcsph,paper)");
+  const auto precisions = split(a.precisions);
+  for (const auto& p : precisions)
+    if (p != "float" && p != "double")
+      throw InputError("--precisions: unknown precision '" + p + "' (expected float,double)");
+  if (a.steps < 1) throw InputError("--steps: must be >= 1, got " + std::to_string(a.steps));
+  if (a.warmup < 0) throw InputError("--warmup: must be >= 0, got " + std::to_string(a.warmup));
+  if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
+  int steps = a.steps, warmup = a.warmup;
+  if (a.quick) {
+    sizes = {2000};
+    steps = std::min(steps, 3);
+    warmup = std::min(warmup, 1);
+  }
+  ScopedThreads threads(a.threads);
+
+  std::printf("cellsph bench sph: %d thread(s), %d warm-up step(s), then the mean of %d step(s)\n",
+              max_threads(), warmup, steps);
+  std::printf(
+      "  search = NeighborSearch build + find_all (Verlet lists: only when a particle has moved\n"
+      "  0.45 skin; builds = searches run in the timed steps) + the displacement check; dynamics =\n"
+      "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
+      "  nbr%% = search / step.\n");
+
+  std::printf("\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double) ==\n");
+  std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
+              "step ms", "nbr%", "builds", "pairs");
+  for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
+    std::string source;
+    const nlohmann::json base = read_scene_json(name, source);
+    for (Method m : methods) {
+      nlohmann::json j = base;
+      j["neighbors"]["method"] = std::string(method_name(m));
+      const StepFigures f = time_scene(j, source, warmup, steps);
+      const double step = f.neighbors_ms + f.dynamics_ms;
+      std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
+                  std::string(method_name(m)).c_str(), f.neighbors_ms, f.dynamics_ms, step,
+                  100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
+                  static_cast<unsigned long long>(f.pairs));
+      std::fflush(stdout);
+    }
+  }
+
+  std::string source;
+  const nlohmann::json base = read_scene_json("dam-break-3d", source);
+  const double volume = fluid_volume(base, source);
+  std::printf(
+      "\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
+      "support 2 s, walls kept), Cell Indexing ==\n");
+  std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s\n", "model", "real", "fluid", "total",
+              "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s");
+  for (std::size_t n : sizes) {
+    const double spacing = std::cbrt(volume / static_cast<double>(n));
+    for (const auto& model : models) {
+      for (const auto& prec : precisions) {
+        nlohmann::json j = base;
+        j["spacing"] = spacing;
+        j["solver"]["support"] = 2 * spacing;
+        j["solver"]["model"] = model;
+        j["precision"] = prec;
+        j["neighbors"]["method"] = "cell-index";
+        const StepFigures f = time_scene(j, source, warmup, steps);
+        const double step = f.neighbors_ms + f.dynamics_ms;
+        std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f\n", model.c_str(),
+                    prec.c_str(), f.fluid, f.total, f.neighbors_ms, f.dynamics_ms, f.wall_ms,
+                    100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
+                    static_cast<double>(f.fluid) / (f.wall_ms * 1e3));
+        std::fflush(stdout);
+        ::malloc_trim(0);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void register_bench(CLI::App& app, int& result) {
@@ -309,6 +476,25 @@ void register_bench(CLI::App& app, int& result) {
   nb->callback([args, threads, &result] {
     args->threads_given = threads->count() > 0;
     run_bench_neighbors(*args);
+    result = 0;
+  });
+
+  auto sargs = std::make_shared<SphArgs>();
+  auto* sph =
+      sub->add_subcommand("sph", "SPH step: Table 1 split (search / dynamics) and 3D particle-steps/s");
+  sph->add_option("--sizes", sargs->sizes, "comma-separated fluid particle counts of the 3D dam break")
+      ->capture_default_str();
+  sph->add_option("--steps", sargs->steps, "timed steps per case")->capture_default_str();
+  sph->add_option("--warmup", sargs->warmup, "untimed steps first")->capture_default_str();
+  sph->add_option("--threads", sargs->threads, "threads")->capture_default_str();
+  sph->add_option("--methods", sargs->methods,
+                  "comma-separated methods for Table 1 (default: all): " + method_names_joined(","));
+  sph->add_option("--models", sargs->models, "models of the 3D runs: wcsph,paper")->capture_default_str();
+  sph->add_option("--precisions", sargs->precisions, "precisions of the 3D runs: float,double")
+      ->capture_default_str();
+  sph->add_flag("--quick", sargs->quick, "tiny sizes (2000 fluid particles, 3 steps), for tests and docs");
+  sph->callback([sargs, &result] {
+    run_bench_sph(*sargs);
     result = 0;
   });
 

@@ -5,7 +5,7 @@
 # build/cellsph (comments after '#' dropped). They run in a scratch folder that links the repo's
 # scenes/ and the given build, after a small points.csv is made for the `neighbors` examples.
 # Long runs are shortened by SHORTEN (appended to `run` commands that have no --until/--steps),
-# and `bench neighbors` without --quick gets --quick, since CI has 2 cores.
+# and `bench neighbors` or `bench sph` without --quick gets --quick, since CI has 2 cores.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$(cd "${1:?build dir}" && pwd)"
@@ -27,7 +27,7 @@ while IFS= read -r line; do
     *" run"*) case "$cmd" in *--until*|*--steps*|*--help*) ;; *) cmd="$cmd --until 0.02" ;; esac ;;
   esac
   case "$cmd" in
-    *"bench neighbors"*) case "$cmd" in *--quick*) ;; *) cmd="$cmd --quick" ;; esac ;;
+    *"bench neighbors"*|*"bench sph"*) case "$cmd" in *--quick*) ;; *) cmd="$cmd --quick" ;; esac ;;
   esac
   # Tour runs are long at full length; keep their options but cap the simulated time.
   cmd="$(echo "$cmd" | sed -E 's/--until ([0-9.]+)/--until 0.02/')"

@@ -112,6 +112,26 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
   f_pressure_.assign(n, V{});
   init_boundary_weights();
+  fluid_.clear();
+  fluid_.reserve(fluid_count_);
+  // 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
+  skin_ = Real(0.15) * cfg_.support;
+  search_h_.assign(n, Real(0));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p_.kind[i] != kFluid) continue;
+    fluid_.push_back(static_cast<std::uint32_t>(i));
+    search_h_[i] = p_.h[i] + skin_;
+  }
+  lists_valid_ = false;
+}
+
+// f(i) for every fluid particle, split statically over the fluid particles alone: boundary particles
+// (often as many as the fluid, and stored after it) would otherwise leave one thread idle.
+template <int Dim, class Real>
+template <class F>
+void Simulation<Dim, Real>::for_fluid(F&& f) const {
+  const std::uint32_t* idx = fluid_.data();
+  parallel_for(fluid_.size(), [&](std::size_t k) { f(static_cast<std::size_t>(idx[k])); });
 }
 
 // Akinci et al. 2012: V_b = 1 / sum_k W_bk over boundary particles (self included), psi_b = rho0 V_b.
@@ -119,7 +139,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
 template <int Dim, class Real>
 void Simulation<Dim, Real>::init_boundary_weights() {
   if (fluid_count_ == p_.size()) return;
-  compute_neighbors();
+  compute_neighbors(true);
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
     parallel_for(p_.size(), [&](std::size_t b) {
       if (p_.kind[b] != kBoundary || p_.m[b] > 0) return;  // a weight given by the scene is kept
@@ -132,19 +152,43 @@ void Simulation<Dim, Real>::init_boundary_weights() {
 }
 
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_neighbors() {
-  search_.build(std::span<const V>(p_.x), std::span<const Real>(p_.h));
+void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
+  // Boundary rows are never read by a step (j is a neighbour of i iff |x_i - x_j| <= h_i, so fluid rows
+  // do not depend on the boundary's support).
+  if (boundary_rows || search_h_.size() != p_.size()) {
+    search_.build(std::span<const V>(p_.x), std::span<const Real>(p_.h));
+    search_.find_all(nl_);
+    lists_valid_ = false;
+    return;
+  }
+  if (lists_valid_) {
+    Real d2 = 0;  // largest squared displacement since the lists were built (order-free: a maximum)
+    const auto count = static_cast<std::int64_t>(fluid_.size());
+#pragma omp parallel for schedule(static) reduction(max : d2)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const std::size_t i = fluid_[static_cast<std::size_t>(k)];
+      d2 = std::max(d2, distance2(p_.x[i], x_built_[i]));
+    }
+    const Real limit = Real(0.45) * skin_;
+    if (d2 <= limit * limit) return;
+  }
+  search_.build(std::span<const V>(p_.x), std::span<const Real>(search_h_));
   search_.find_all(nl_);
+  x_built_ = p_.x;
+  lists_valid_ = true;
+  ++timings_.list_builds;
 }
 
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_density_pressure() {
   const bool number = cfg_.density == DensityFormulation::Number && cfg_.model == Model::PaperMultiphase;
+  vol_.resize(p_.size());
+  prho2_.resize(p_.size());
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
-    parallel_for(p_.size(), [&](std::size_t i) {
-      if (p_.kind[i] != kFluid) return;
+    for_fluid([&](std::size_t i) {
       const V xi = p_.x[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
       Real rho = 0;
       if (number) {
         // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
@@ -154,17 +198,25 @@ void Simulation<Dim, Real>::compute_density_pressure() {
         const Real inv_vol_i = rho0_[i] / p_.m[i];
         for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
           const std::uint32_t j = *it;
-          const Real wij = w.W2(distance2(xi, p_.x[j]));
+          const Real r2 = distance2(xi, p_.x[j]);
+          if (r2 > hi2) continue;  // in the Verlet skin only
+          const Real wij = w.W2(r2);
           delta += p_.kind[j] == kFluid ? wij : wij * (p_.m[j] / rho0_[j]) * inv_vol_i;
         }
         rho = p_.m[i] * delta;
       } else {
         rho = density_term(w, p_.m[i], Real(0));
-        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it)
-          rho += density_term(w, p_.m[*it], distance2(xi, p_.x[*it]));
+        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+          const Real r2 = distance2(xi, p_.x[*it]);
+          if (r2 > hi2) continue;  // in the Verlet skin only
+          rho += density_term(w, p_.m[*it], r2);
+        }
       }
       p_.rho[i] = rho;
-      p_.p[i] = cfg_.eos.pressure(rho, rho0_[i]);
+      const Real pres = cfg_.eos.pressure(rho, rho0_[i]);
+      p_.p[i] = pres;
+      vol_[i] = p_.m[i] / rho;
+      prho2_[i] = pres / (rho * rho);
     });
   });
 }
@@ -175,12 +227,12 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_normals() {
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
   normal_.assign(p_.size(), V{});
-  parallel_for(p_.size(), [&](std::size_t i) {
-    if (p_.kind[i] != kFluid) return;
+  for_fluid([&](std::size_t i) {
     V n{};
+    const Real hi2 = p_.h[i] * p_.h[i];
     for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
       const std::uint32_t j = *it;
-      if (p_.kind[j] != kFluid) continue;
+      if (p_.kind[j] != kFluid || distance2(p_.x[i], p_.x[j]) > hi2) continue;
       n += wc.gradW(p_.x[i] - p_.x[j]) * (p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
     }
     normal_[i] = n;
@@ -197,11 +249,7 @@ void Simulation<Dim, Real>::compute_forces_paper() {
   const Real thr2 = cfg_.tension_threshold * cfg_.tension_threshold;
   if (csf) compute_normals();
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wp) {
-    parallel_for(p_.size(), [&](std::size_t i) {
-      if (p_.kind[i] != kFluid) {
-        p_.f[i] = V{};
-        return;
-      }
+    for_fluid([&](std::size_t i) {
       if (!due_.empty() && !due_[i]) return;  // per-particle steps: keeps its last force
       const Real vol_i = p_.m[i] / p_.rho[i];
       V f = cfg_.gravity * p_.m[i];
@@ -214,26 +262,27 @@ void Simulation<Dim, Real>::compute_forces_paper() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
       const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
       const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
       Real kappa = 0;  // CSF: -div(n / |n|) over neighbours with a defined normal
+      const V vel_i = p_.v[i];
       for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
+        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
-          in.vij = p_.v[i] - p_.v[j];
-          in.mj = p_.m[j];
-          in.rhoj = p_.rho[j];
-          in.pj = p_.p[j];
-          in.muj = p_.mu[j];
-          f += averaged_pressure_force(in, wp);
-          f += averaged_viscosity_force(in, wv);
+          // averaged_pressure_force and averaged_viscosity_force (eq. 8a, 8b), inlined with the
+          // per-particle volumes of the density pass (same expressions, same order).
+          const Real vv = -vol_i * vol_[j];
+          f += wp.gradW(in.xij) * (vv * (in.pi + p_.p[j]) / 2);
+          f += (vel_i - p_.v[j]) * (vv * (in.mui + p_.mu[j]) / 2 * wv.laplacian(in.r));
           if (csf_i && norm2(normal_[j]) > thr2 && norm2(normal_[j]) > 0) {
             const V nhat_j = normal_[j] / norm(normal_[j]);
-            kappa -= p_.m[j] / p_.rho[j] * dot(nhat_j - nhat_i, wc.gradW(in.xij));
+            kappa -= vol_[j] * dot(nhat_j - nhat_i, wc.gradW(in.xij));
           } else if (any_tension_ && !csf) {
-            accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], p_.color[j], wc);
+            accumulate_color(cf, in.xij, in.r, vol_[j], p_.color[j], wc);
           }
         } else {
           // A boundary particle acts as fluid with i's density (mirrored, so that its volume psi_b / rho_i
@@ -270,13 +319,10 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
   const Real lap_self = wc.laplacian(0);
   const Real h = cfg_.support;
+  const Real eps2 = Real(0.01) * h * h;     // Monaghan's r^2 regulariser
+  const Real visc_c = Real(2 * (Dim + 2));  // 2 (d + 2)
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wg) {
-    parallel_for(p_.size(), [&](std::size_t i) {
-      if (p_.kind[i] != kFluid) {
-        p_.f[i] = V{};
-        f_pressure_[i] = V{};
-        return;
-      }
+    for_fluid([&](std::size_t i) {
       const Real vol_i = p_.m[i] / p_.rho[i];
       V fnp = cfg_.gravity * p_.m[i];
       V fp{};
@@ -287,19 +333,22 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
+      const V vel_i = p_.v[i];
+      const Real prho2_i = prho2_[i];
       for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
+        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
-          in.vij = p_.v[i] - p_.v[j];
-          in.mj = p_.m[j];
-          in.rhoj = p_.rho[j];
-          in.pj = p_.p[j];
-          in.muj = p_.mu[j];
-          fnp += monaghan_viscosity_force(in, wg, h);
-          fp += symmetric_pressure_force(in, wg);
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / p_.rho[j], Real(1), wc);
+          // monaghan_viscosity_force and symmetric_pressure_force, inlined with one kernel gradient
+          // and the per-particle quotients of the density pass (same expressions, same order).
+          const V g = wg.gradW(in.xij);
+          const Real q = dot(vel_i - p_.v[j], in.xij) / (in.r * in.r + eps2);
+          fnp += g * (visc_c * (in.mui + p_.mu[j]) / 2 * vol_i * vol_[j] * q);
+          fp += g * (-in.mi * p_.m[j] * (prho2_i + prho2_[j]));
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, vol_[j], Real(1), wc);
         } else {
           Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
@@ -335,8 +384,11 @@ Real Simulation<Dim, Real>::choose_dt() const {
   if (nu_max > 0) dt = std::min(dt, cfg_.time.viscous * h * h / nu_max);
   Real v2 = 0, a2 = 0;
   const bool wcsph = cfg_.model == Model::Wcsph;
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    if (p_.kind[i] != kFluid) continue;
+  // A maximum does not depend on the order of evaluation: parallel and still deterministic.
+  const auto count = static_cast<std::int64_t>(fluid_.size());
+#pragma omp parallel for schedule(static) reduction(max : v2, a2)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const std::size_t i = fluid_[static_cast<std::size_t>(k)];
     v2 = std::max(v2, norm2(p_.v[i]));
     const V f = wcsph ? p_.f[i] + f_pressure_[i] : p_.f[i];
     a2 = std::max(a2, norm2(f) / (p_.m[i] * p_.m[i]));
@@ -352,8 +404,7 @@ Real Simulation<Dim, Real>::choose_dt() const {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::integrate_paper(Real dt) {
   const Real kick = leapfrog_started_ ? (last_dt_ + dt) / 2 : dt / 2;
-  parallel_for(p_.size(), [&](std::size_t i) {
-    if (p_.kind[i] != kFluid) return;
+  for_fluid([&](std::size_t i) {
     p_.v[i] += p_.f[i] * (kick / p_.m[i]);
     p_.x[i] += p_.v[i] * dt;
   });
@@ -364,8 +415,7 @@ void Simulation<Dim, Real>::integrate_paper(Real dt) {
 // x(t+dt) = x + dt v(t+dt) (symplectic Euler).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::integrate_wcsph(Real dt) {
-  parallel_for(p_.size(), [&](std::size_t i) {
-    if (p_.kind[i] != kFluid) return;
+  for_fluid([&](std::size_t i) {
     const V vstar = p_.v[i] + p_.f[i] * (dt / p_.m[i]);
     p_.v[i] = vstar + f_pressure_[i] * (dt / p_.m[i]);
     p_.x[i] += p_.v[i] * dt;
@@ -376,8 +426,7 @@ void Simulation<Dim, Real>::integrate_wcsph(Real dt) {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::apply_walls() {
   if (!cfg_.box.enabled && cfg_.planes.empty()) return;
-  parallel_for(p_.size(), [&](std::size_t i) {
-    if (p_.kind[i] != kFluid) return;
+  for_fluid([&](std::size_t i) {
     if (cfg_.box.enabled)
       box_collision(p_.x[i], p_.v[i], cfg_.box.lo, cfg_.box.hi, cfg_.box.radius, cfg_.box.damping);
     for (const auto& pl : cfg_.planes)
@@ -389,7 +438,6 @@ void Simulation<Dim, Real>::apply_walls() {
 // stops the run with a diagnosis.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::check_state() const {
-  const std::size_t n = p_.size();
   V lo{}, hi{};
   bool escape = false;
   if (cfg_.domain_set) {
@@ -411,11 +459,12 @@ void Simulation<Dim, Real>::check_state() const {
     return false;
   };
   std::int64_t first = std::numeric_limits<std::int64_t>::max();
-  const auto count = static_cast<std::int64_t>(n);
+  const auto count = static_cast<std::int64_t>(fluid_.size());
 #pragma omp parallel for schedule(static) reduction(min : first)
-  for (std::int64_t i = 0; i < count; ++i)
-    if (p_.kind[static_cast<std::size_t>(i)] == kFluid && bad(static_cast<std::size_t>(i)))
-      first = std::min(first, i);
+  for (std::int64_t k = 0; k < count; ++k) {
+    const std::uint32_t i = fluid_[static_cast<std::size_t>(k)];
+    if (bad(i)) first = std::min(first, static_cast<std::int64_t>(i));
+  }
   if (first == std::numeric_limits<std::int64_t>::max()) return;
 
   const auto i = static_cast<std::size_t>(first);
@@ -690,8 +739,15 @@ void Simulation<Dim, Real>::load_state(std::istream& in) {
     }
   }
   p_ = std::move(loaded);
-  for (std::size_t i = 0; i < p_.size(); ++i)
+  fluid_.clear();
+  for (std::size_t i = 0; i < p_.size(); ++i) {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
+    const bool fluid = p_.kind[i] == kFluid;
+    if (fluid) fluid_.push_back(static_cast<std::uint32_t>(i));
+    search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
+  }
+  fluid_count_ = fluid_.size();
+  lists_valid_ = false;
   time_ = t;
   last_dt_ = ldt;
   steps_ = st;

@@ -23,9 +23,10 @@ namespace cellsph {
 
 // Wall-clock time spent in each phase of step(), accumulated over all steps [ms].
 struct StepTimings {
-  double neighbors = 0;    // building the search structure and the CSR lists
-  double forces = 0;       // density, pressure, forces
-  double integration = 0;  // time step choice, integration, walls, stability check
+  double neighbors = 0;           // building the search structure and the CSR lists
+  double forces = 0;              // density, pressure, forces
+  double integration = 0;         // time step choice, integration, walls, stability check
+  std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
 };
 
 template <int Dim, class Real>
@@ -72,7 +73,11 @@ class Simulation {
   static constexpr std::uint32_t kStateVersion = 2;  // 2: the per-particle "tick" field
 
  private:
-  void compute_neighbors();
+  // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
+  // fluid rows, so boundary particles are then searched with support 0.
+  void compute_neighbors(bool boundary_rows = false);
+  template <class F>
+  void for_fluid(F&& f) const;
   void compute_density_pressure();
   void compute_forces_paper();
   void compute_normals();
@@ -90,11 +95,26 @@ class Simulation {
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
-  std::vector<V> normal_;          // CSF: colour gradient n_i of the current step
-  std::vector<V> f_pressure_;      // WCSPH: pressure force, applied after the predicted velocity
-  std::vector<Real> rho0_;         // rest density per particle (from its phase)
-  std::vector<V> xs_;              // per-particle steps: every position extrapolated to the global clock
-  std::vector<std::uint8_t> due_;  // per-particle steps: 1 for the particles integrated this step
+  std::vector<V> normal_;      // CSF: colour gradient n_i of the current step
+  std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
+  std::vector<Real> rho0_;     // rest density per particle (from its phase)
+  // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair
+  // (the same expressions as before, so the values are bit for bit those computed per pair).
+  std::vector<Real> vol_;             // V_j = m_j / rho_j
+  std::vector<Real> prho2_;           // p_j / rho_j^2 (WCSPH symmetric pressure)
+  std::vector<V> xs_;                 // per-particle steps: every position extrapolated to the global clock
+  std::vector<std::uint8_t> due_;     // per-particle steps: 1 for the particles integrated this step
+  std::vector<std::uint32_t> fluid_;  // indices of the fluid particles, ascending (kinds never change)
+  // Verlet lists: the step's CSR lists hold the pairs within h + skin of the positions x_built_ and are
+  // kept while no particle has moved more than 0.45 skin since (then every pair within h now was
+  // within h + skin then: triangle inequality). Every pair loop skips pairs with
+  // distance2(x_i, x_j) > h_i^2, the search's own test, so each sum runs over exactly the neighbours
+  // an exact search gives, in the same (ascending) order: results do not depend on the skin, the
+  // rebuild schedule, the method or a resume.
+  std::vector<Real> search_h_;  // support per particle for the lists: h + skin (0 for boundary)
+  std::vector<V> x_built_;      // positions the lists were built from
+  Real skin_ = 0;
+  bool lists_valid_ = false;
   bool any_tension_ = false;
   std::size_t fluid_count_ = 0;
 
