@@ -22,3 +22,7 @@ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLSPH_SA
 cmake --build build/asan -j "$JOBS"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/asan -j "$JOBS" --output-on-failure
+
+echo "== the README's first command: the default scene =="
+scripts/run.sh
+test -s dam-break-2d/frames.csv && test -s dam-break-2d/particles.pvd
