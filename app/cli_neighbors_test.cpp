@@ -7,9 +7,9 @@
 #ifdef CELLSPH_BINARY
 #include <gtest/gtest.h>
 
-#include "cli_test_util.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
+#include "cli_test_util.hpp"
 
 #include <algorithm>
 #include <atomic>

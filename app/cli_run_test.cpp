@@ -90,10 +90,12 @@ TEST(CliRun, WritesEveryFormatTheIndexAndTheCollection) {
 TEST(CliRun, ResumeContinuesBitForBit) {
   TempDir dir;
   write_file(dir / "tiny.json", kTiny);
-  auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "whole") + " --quiet --format csv");
+  auto r =
+      run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "whole") + " --quiet --format csv");
   ASSERT_EQ(r.code, 0) << r.err;
   // Stop half-way, then resume to the same end.
-  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "parts") + " --quiet --format csv --until 0.05");
+  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "parts") +
+                       " --quiet --format csv --until 0.05");
   ASSERT_EQ(r.code, 0) << r.err;
   ASSERT_FALSE(fs::exists(dir / "parts" / "frame_00005.csv"));
   r = run_cli(dir, "run --resume " + q(dir / "parts") + " --until 0.1 --quiet");
@@ -112,10 +114,12 @@ TEST(CliRun, ResumeExtendsAFinishedRunAndRestartsWithoutCheckpoint) {
   std::string scene = kTiny;
   scene.replace(scene.find("\"checkpoint_every\": 1"), 21, "\"checkpoint_every\": 100");
   write_file(dir / "tiny.json", scene);
-  auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "whole") + " --quiet --format csv");
+  auto r =
+      run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "whole") + " --quiet --format csv");
   ASSERT_EQ(r.code, 0) << r.err;
   // No frame reaches a checkpoint here; the end state is saved, so the run can be extended.
-  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "ext") + " --quiet --format csv --until 0.05");
+  r = run_cli(
+      dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "ext") + " --quiet --format csv --until 0.05");
   ASSERT_EQ(r.code, 0) << r.err;
   r = run_cli(dir, "run --resume " + q(dir / "ext") + " --until 0.1 --quiet");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -135,7 +139,8 @@ TEST(CliRun, SameResultWithEveryNeighbourMethod) {
   std::string reference;
   for (const char* m : {"all-pairs", "spatial-hash", "cell-index", "sorted-grid", "kd-tree"}) {
     const auto out = dir / m;
-    const auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(out) + " --quiet --format csv --method " + m);
+    const auto r = run_cli(
+        dir, "run " + q(dir / "tiny.json") + " --out " + q(out) + " --quiet --format csv --method " + m);
     ASSERT_EQ(r.code, 0) << m << ": " << r.err;
     const std::string last = read_file(out / "frame_00005.csv");
     ASSERT_FALSE(last.empty());
@@ -203,7 +208,8 @@ TEST(CliRun, SurfaceWritesOneMeshPerFrameAndPhase) {
     EXPECT_NE(mesh.find("\nv "), std::string::npos) << "frame " << f << " has no vertices";
     EXPECT_NE(mesh.find("\nf "), std::string::npos) << "frame " << f << " has no faces";
   }
-  const auto bad = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "bad") + " --surface-format stl");
+  const auto bad =
+      run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "bad") + " --surface-format stl");
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("stl"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad")) << "a bad option must not leave an output folder behind";
@@ -213,8 +219,9 @@ TEST(CliRun, HelpDocumentsEveryOption) {
   TempDir dir;
   const auto r = run_cli(dir, "run --help");
   EXPECT_EQ(r.code, 0);
-  for (const char* opt : {"--out", "--threads", "--method", "--until", "--steps", "--fps", "--format", "--render",
-                          "--color-by", "--surface", "--surface-format", "--quiet", "--resume", "default"})
+  for (const char* opt :
+       {"--out", "--threads", "--method", "--until", "--steps", "--fps", "--format", "--render", "--color-by",
+        "--surface", "--surface-format", "--quiet", "--resume", "default"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt << " missing from --help:\n" << r.out;
 }
 

@@ -2,12 +2,12 @@
 // ParaView (VTU + PVD), Blender (PLY) and scripts (CSV, frames.csv) open, optional PNG pictures and an
 // MP4, checkpoints, and a resume that continues bit for bit.
 #include <cmath>
-#include <cstring>
-#include <memory>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -72,7 +72,9 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   auto& cfg = scene.solver;
   if (!opt.method.empty()) {
     auto m = parse_method(opt.method);
-    if (!m) throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() + ")");
+    if (!m)
+      throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() +
+                       ")");
     cfg.search.method = *m;
   }
   OutputSettings os = scene.output;
@@ -91,7 +93,9 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   std::filesystem::create_directories(out);
   Simulation<Dim, Real> sim(cfg, std::move(scene.particles));
   const auto& parts = sim.particles();
-  auto is_fluid = [&parts](std::size_t i) { return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid); };
+  auto is_fluid = [&parts](std::size_t i) {
+    return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid);
+  };
   FrameOutput<Dim, Real> frames(out, formats, is_fluid);
 
   LoopState loop;
@@ -100,7 +104,8 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     // Killed before its first checkpoint: the run is deterministic, so starting again from t = 0 gives
     // exactly what continuing would have.
     if (!opt.quiet)
-      std::fprintf(stderr, "cellsph: %s has no checkpoint yet; starting again from t = 0\n", out.string().c_str());
+      std::fprintf(stderr, "cellsph: %s has no checkpoint yet; starting again from t = 0\n",
+                   out.string().c_str());
     resuming = false;
   }
   if (resuming) {
@@ -155,7 +160,8 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     Stopwatch sw;
     const double t = double(sim.time());
     if (formats.any()) frames.write(sim.particles(), loop.next_frame, t);
-    if (opt.render) render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
+    if (opt.render)
+      render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
     if (opt.surface) write_surfaces(sim.particles(), sopt, surface_dir, loop.next_frame);
     ++loop.next_frame;
     if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0)
@@ -177,13 +183,14 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   while (!done()) {
     sim.step();
     while (double(sim.time()) >= double(loop.next_frame) * frame_dt * (1 - 1e-12)) write_frame();
-    const double frac = opt.steps >= 0 ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
-                                       : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
+    const double frac = opt.steps >= 0
+                            ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
+                            : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
     const double w = wall.seconds();
-    progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) + " s  frame " +
-                              std::to_string(loop.next_frame) + "  " +
-                              fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) + " steps/s  " +
-                              std::to_string(sim.fluid_count()) + " fluid particles");
+    progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
+                              " s  frame " + std::to_string(loop.next_frame) + "  " +
+                              fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
+                              " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles");
   }
   progress.finish();
   // The end state too, so that a finished run can be extended with --resume DIR --until LATER.
@@ -204,13 +211,14 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     const std::uint64_t steps = sim.steps() - steps_at_start;
     const double total_ms = tm.neighbors + tm.forces + tm.integration + output_ms;
     auto pct = [&](double ms) { return fmt("%.0f%%", 100.0 * ms / std::max(total_ms, 1e-9)); };
-    std::fprintf(stderr,
-                 "cellsph: done: simulated %.4g s in %s wall, %llu steps (mean dt %.3g s), %llu frames in %s\n"
-                 "         time split: neighbours %s, forces %s, integration %s, output %s\n",
-                 double(sim.time()), Progress::format_duration(w).c_str(), static_cast<unsigned long long>(steps),
-                 steps ? (double(sim.time()) - t_at_start) / double(steps) : 0.0,
-                 static_cast<unsigned long long>(loop.next_frame), out.string().c_str(), pct(tm.neighbors).c_str(),
-                 pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
+    std::fprintf(
+        stderr,
+        "cellsph: done: simulated %.4g s in %s wall, %llu steps (mean dt %.3g s), %llu frames in %s\n"
+        "         time split: neighbours %s, forces %s, integration %s, output %s\n",
+        double(sim.time()), Progress::format_duration(w).c_str(), static_cast<unsigned long long>(steps),
+        steps ? (double(sim.time()) - t_at_start) / double(steps) : 0.0,
+        static_cast<unsigned long long>(loop.next_frame), out.string().c_str(), pct(tm.neighbors).c_str(),
+        pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
   }
   return 0;
 }
@@ -225,7 +233,8 @@ int run_command(RunOptions opt) {
     out = opt.resume;
     const auto run_file = out / kRunFile;
     if (!std::filesystem::exists(run_file))
-      throw InputError("--resume " + out.string() + ": no " + kRunFile + " there (not a cellsph output folder)");
+      throw InputError("--resume " + out.string() + ": no " + kRunFile +
+                       " there (not a cellsph output folder)");
     const auto saved = JsonReader::parse_file(run_file);
     try {
       scene_json = saved.at("scene");
@@ -249,12 +258,14 @@ int run_command(RunOptions opt) {
     scene_json = read_scene_json(opt.scene, source);
   }
   const SceneHeader header = read_scene_header(scene_json, source);
-  if (out.empty()) out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
+  if (out.empty())
+    out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
 
   // Option errors come before anything is written.
   parse_surface_format(opt.surface_format);
   if (!opt.method.empty() && !parse_method(opt.method))
-    throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() + ")");
+    throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() +
+                     ")");
   if (!opt.formats.empty()) parse_output_formats(opt.formats, "--format");
   if (!opt.color_by.empty()) parse_color_by(opt.color_by, "--color-by");
 
@@ -264,10 +275,10 @@ int run_command(RunOptions opt) {
     nlohmann::json saved;
     saved["scene"] = scene_json;
     saved["source"] = source;
-    saved["options"] = {{"method", opt.method}, {"fps", opt.fps},   {"formats", opt.formats},
-                        {"until", opt.until},   {"steps", opt.steps}, {"render", opt.render},
-                        {"color_by", opt.color_by}, {"surface", opt.surface},
-                        {"surface_format", opt.surface_format}};
+    saved["options"] = {
+        {"method", opt.method},     {"fps", opt.fps},         {"formats", opt.formats},
+        {"until", opt.until},       {"steps", opt.steps},     {"render", opt.render},
+        {"color_by", opt.color_by}, {"surface", opt.surface}, {"surface_format", opt.surface_format}};
     write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
   }
   if (header.dim == 2)
@@ -281,11 +292,12 @@ int run_command(RunOptions opt) {
 
 void register_run(CLI::App& app, int& result) {
   auto opt = std::make_shared<RunOptions>();
-  auto* sub = app.add_subcommand("run", "Run a scene (built-in name or JSON file; default: " +
-                                            std::string(kDefaultScene) + ")");
+  auto* sub = app.add_subcommand(
+      "run", "Run a scene (built-in name or JSON file; default: " + std::string(kDefaultScene) + ")");
   sub->add_option("scene", opt->scene, "Built-in scene name (see `cellsph scenes`) or a scene .json file");
   sub->add_option("--out", opt->out, "Output folder (default: a folder named after the scene)");
-  sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)")->check(CLI::PositiveNumber);
+  sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
   sub->add_option("--method", opt->method,
                   "Neighbour search: " + method_names_joined() + " (default: the scene's, else cell-index)");
   sub->add_option("--until", opt->until, "Simulated end time in seconds (default: the scene's time.end)")
@@ -294,11 +306,15 @@ void register_run(CLI::App& app, int& result) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--fps", opt->fps, "Output frames per simulated second (default: the scene's output.fps)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--format", opt->formats, "Frame formats, any of vtu,ply,csv (default: the scene's output.formats)");
-  sub->add_flag("--render", opt->render, "Also write a PNG picture per frame (and an MP4 if ffmpeg is installed)");
-  sub->add_option("--color-by", opt->color_by, "Picture colours: phase, speed or pressure (default: the scene's)");
+  sub->add_option("--format", opt->formats,
+                  "Frame formats, any of vtu,ply,csv (default: the scene's output.formats)");
+  sub->add_flag("--render", opt->render,
+                "Also write a PNG picture per frame (and an MP4 if ffmpeg is installed)");
+  sub->add_option("--color-by", opt->color_by,
+                  "Picture colours: phase, speed or pressure (default: the scene's)");
   sub->add_flag("--surface", opt->surface,
-                "Also write the fluid surface per frame and phase (surface/surface_PHASE_NNNNN.ply), see docs/surfaces.md");
+                "Also write the fluid surface per frame and phase (surface/surface_PHASE_NNNNN.ply), see "
+                "docs/surfaces.md");
   sub->add_option("--surface-format", opt->surface_format, "Surface mesh format: ply or obj (default: ply)");
   sub->add_flag("--quiet", opt->quiet, "No progress line and no summary");
   sub->add_option("--resume", opt->resume, "Continue the run in this output folder from its last checkpoint");

@@ -21,9 +21,10 @@ std::filesystem::path temp_name(const std::filesystem::path& target) {
 
 AtomicFile::AtomicFile(std::filesystem::path target, bool binary)
     : target_(std::move(target)), temp_(temp_name(target_)) {
-  out_.open(temp_, binary ? std::ios::out | std::ios::binary | std::ios::trunc
-                          : std::ios::out | std::ios::trunc);
-  if (!out_) throw InputError("cannot write file '" + target_.string() + "' (temporary '" + temp_.string() + "')");
+  out_.open(temp_,
+            binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
+  if (!out_)
+    throw InputError("cannot write file '" + target_.string() + "' (temporary '" + temp_.string() + "')");
 }
 
 AtomicFile::~AtomicFile() {
@@ -46,7 +47,8 @@ void AtomicFile::commit() {
   }
   std::error_code ec;
   std::filesystem::rename(temp_, target_, ec);
-  if (ec) throw InputError("cannot rename '" + temp_.string() + "' to '" + target_.string() + "': " + ec.message());
+  if (ec)
+    throw InputError("cannot rename '" + temp_.string() + "' to '" + target_.string() + "': " + ec.message());
   committed_ = true;
 }
 

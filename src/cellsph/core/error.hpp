@@ -33,11 +33,11 @@ namespace detail {
 }  // namespace cellsph
 
 // Cheap internal invariant, kept in release builds.
-#define CELLSPH_CHECK(cond, msg)                                                         \
-  do {                                                                                   \
-    if (!(cond)) {                                                                       \
-      std::ostringstream cellsph_check_os_;                                              \
-      cellsph_check_os_ << msg; /* NOLINT */                                             \
+#define CELLSPH_CHECK(cond, msg)                                                           \
+  do {                                                                                     \
+    if (!(cond)) {                                                                         \
+      std::ostringstream cellsph_check_os_;                                                \
+      cellsph_check_os_ << msg; /* NOLINT */                                               \
       ::cellsph::detail::check_failed(#cond, __FILE__, __LINE__, cellsph_check_os_.str()); \
-    }                                                                                    \
+    }                                                                                      \
   } while (false)

@@ -8,8 +8,12 @@
 
 namespace cellsph {
 
-inline int max_threads() { return omp_get_max_threads(); }
-inline int thread_id() { return omp_get_thread_num(); }
+inline int max_threads() {
+  return omp_get_max_threads();
+}
+inline int thread_id() {
+  return omp_get_thread_num();
+}
 
 // Sets the number of threads for the lifetime of the object, restoring the previous value after.
 class ScopedThreads {

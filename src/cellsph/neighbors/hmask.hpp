@@ -42,7 +42,9 @@ inline int mask_gap2(const std::array<int, Dim>& o) {
 }
 
 // Largest offset along one axis that can be needed for support `reach` (in cell units).
-inline int mask_radius(double reach) { return static_cast<int>(std::floor(reach * kMaskSlack)) + 1; }
+inline int mask_radius(double reach) {
+  return static_cast<int>(std::floor(reach * kMaskSlack)) + 1;
+}
 
 // True when a cell with squared gap `gap2` (cell units) may hold a neighbour within `reach` cells.
 inline bool mask_keeps(int gap2, double reach) {

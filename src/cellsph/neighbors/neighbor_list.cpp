@@ -4,11 +4,16 @@ namespace cellsph {
 
 std::string_view method_name(Method m) {
   switch (m) {
-    case Method::AllPairs: return "all-pairs";
-    case Method::SpatialHash: return "spatial-hash";
-    case Method::CellIndex: return "cell-index";
-    case Method::SortedGrid: return "sorted-grid";
-    case Method::KdTree: return "kd-tree";
+    case Method::AllPairs:
+      return "all-pairs";
+    case Method::SpatialHash:
+      return "spatial-hash";
+    case Method::CellIndex:
+      return "cell-index";
+    case Method::SortedGrid:
+      return "sorted-grid";
+    case Method::KdTree:
+      return "kd-tree";
   }
   return "unknown";
 }

@@ -31,10 +31,10 @@ struct SearchOptions {
 };
 
 struct SearchStats {
-  double build_ms = 0;          // building the structure (sort, hash, tree)
-  double query_ms = 0;          // finding all neighbours
-  std::uint64_t pairs = 0;      // ordered pairs (i, j) found
-  std::uint64_t candidates = 0; // distance tests performed
+  double build_ms = 0;             // building the structure (sort, hash, tree)
+  double query_ms = 0;             // finding all neighbours
+  std::uint64_t pairs = 0;         // ordered pairs (i, j) found
+  std::uint64_t candidates = 0;    // distance tests performed
   std::uint64_t memory_bytes = 0;  // bytes held by the structure and the output lists
 };
 

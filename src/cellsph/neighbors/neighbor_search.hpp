@@ -88,11 +88,21 @@ class NeighborSearch {
  private:
   void reset_impl() {
     switch (opt_.method) {
-      case Method::AllPairs: impl_.template emplace<AllPairs<Dim, Real>>(opt_); break;
-      case Method::SpatialHash: impl_.template emplace<SpatialHash<Dim, Real>>(opt_); break;
-      case Method::CellIndex: impl_.template emplace<CellIndex<Dim, Real>>(opt_); break;
-      case Method::SortedGrid: impl_.template emplace<SortedGrid<Dim, Real>>(opt_); break;
-      case Method::KdTree: impl_.template emplace<KdTree<Dim, Real>>(opt_); break;
+      case Method::AllPairs:
+        impl_.template emplace<AllPairs<Dim, Real>>(opt_);
+        break;
+      case Method::SpatialHash:
+        impl_.template emplace<SpatialHash<Dim, Real>>(opt_);
+        break;
+      case Method::CellIndex:
+        impl_.template emplace<CellIndex<Dim, Real>>(opt_);
+        break;
+      case Method::SortedGrid:
+        impl_.template emplace<SortedGrid<Dim, Real>>(opt_);
+        break;
+      case Method::KdTree:
+        impl_.template emplace<KdTree<Dim, Real>>(opt_);
+        break;
     }
   }
 

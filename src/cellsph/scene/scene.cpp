@@ -33,7 +33,8 @@ nlohmann::json read_scene_json(const std::string& name_or_path, std::string& sou
 }
 
 SceneHeader read_scene_header(const nlohmann::json& j, const std::string& source) {
-  if (!j.is_object()) throw InputError(source + ": /: a scene must be a JSON object, got " + json_value_text(j));
+  if (!j.is_object())
+    throw InputError(source + ": /: a scene must be a JSON object, got " + json_value_text(j));
   JsonReader r(j, source, "");
   SceneHeader h;
   h.name = r.string("name", "scene");
@@ -222,8 +223,8 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   }
 
   // --- boundary -------------------------------------------------------------------------------
-  std::vector<Aabb<Dim>> solids;                 // regions fluid must not overlap
-  std::optional<Aabb<Dim>> container;            // region fluid must lie in
+  std::vector<Aabb<Dim>> solids;       // regions fluid must not overlap
+  std::optional<Aabb<Dim>> container;  // region fluid must lie in
   auto& p = s.particles;
   if (r.has("boundary")) {
     auto br = r.child("boundary");
@@ -333,12 +334,12 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
                           std::to_string(b.hi[a] - b.lo[a]) + " < spacing " + std::to_string(spacing) + ")");
     for (std::size_t o = 0; o < blocks.size(); ++o)
       if (overlap<Dim>(b, blocks[o], tol))
-        e.fail_here("overlaps fluid block " + std::to_string(o) + " (particles would sit on top of each other)");
+        e.fail_here("overlaps fluid block " + std::to_string(o) +
+                    " (particles would sit on top of each other)");
     for (std::size_t o = 0; o < solids.size(); ++o)
       if (overlap<Dim>(b, solids[o], tol))
         e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
-    if (container && !inside<Dim>(b, *container, tol))
-      e.fail_here("lies (partly) outside the boundary box");
+    if (container && !inside<Dim>(b, *container, tol)) e.fail_here("lies (partly) outside the boundary box");
     blocks.push_back(b);
     const std::size_t first = p.size();
     add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
@@ -352,7 +353,8 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
     s.output.fps = orr.number("fps", s.output.fps, 1e-6, 1e6);
     if (orr.has("formats")) {
       const auto& fj = orr.json()["formats"];
-      if (!fj.is_array()) orr.fail("formats", "expected an array of vtu, ply, csv, got " + json_value_text(fj));
+      if (!fj.is_array())
+        orr.fail("formats", "expected an array of vtu, ply, csv, got " + json_value_text(fj));
       auto list = orr.child("formats");
       s.output.formats.clear();
       for (std::size_t k = 0; k < list.array_size(); ++k) {
@@ -362,7 +364,8 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
         s.output.formats.push_back(v.get<std::string>());
       }
     }
-    s.output.checkpoint_every = static_cast<int>(orr.integer("checkpoint_every", s.output.checkpoint_every, 0, 1000000));
+    s.output.checkpoint_every =
+        static_cast<int>(orr.integer("checkpoint_every", s.output.checkpoint_every, 0, 1000000));
     s.output.color_by = orr.choice("color_by", s.output.color_by, {"phase", "speed", "pressure"});
     s.output.up_axis = static_cast<int>(orr.integer("up_axis", Dim - 1, 0, Dim - 1));
     orr.finish();

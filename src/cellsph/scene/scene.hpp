@@ -26,8 +26,8 @@ struct SceneHeader {
 
 // Output settings of a scene (command-line options override them).
 struct OutputSettings {
-  double end_time = 1.0;  // [s]
-  double fps = 30;        // frames per simulated second
+  double end_time = 1.0;                    // [s]
+  double fps = 30;                          // frames per simulated second
   std::vector<std::string> formats{"vtu"};  // any of vtu, ply, csv
   int checkpoint_every = 10;                // frames between checkpoints; 0 = none
   std::string color_by = "phase";           // phase | speed | pressure

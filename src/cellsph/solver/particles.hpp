@@ -19,15 +19,15 @@ template <int Dim, class Real>
 struct Particles {
   using V = Vec<Dim, Real>;
 
-  std::vector<V> x;        // position [m]
-  std::vector<V> v;        // velocity [m/s]
-  std::vector<V> f;        // total force of the last evaluation [N]
-  std::vector<Real> m;     // mass [kg]
-  std::vector<Real> rho;   // density [kg/m^3]
-  std::vector<Real> p;     // pressure [Pa]
-  std::vector<Real> h;     // support length [m]
-  std::vector<Real> color; // interface colour value c_int (paper eq. 8c)
-  std::vector<Real> mu;    // dynamic viscosity [Pa s]
+  std::vector<V> x;                 // position [m]
+  std::vector<V> v;                 // velocity [m/s]
+  std::vector<V> f;                 // total force of the last evaluation [N]
+  std::vector<Real> m;              // mass [kg]
+  std::vector<Real> rho;            // density [kg/m^3]
+  std::vector<Real> p;              // pressure [Pa]
+  std::vector<Real> h;              // support length [m]
+  std::vector<Real> color;          // interface colour value c_int (paper eq. 8c)
+  std::vector<Real> mu;             // dynamic viscosity [Pa s]
   std::vector<std::int32_t> phase;  // phase index into the scene's phase table
   std::vector<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
   std::vector<std::int64_t> tick;   // per-particle steps: state time in units of dt_max / 2^max_level
@@ -51,9 +51,13 @@ struct Particles {
     fn(std::string_view("kind"), self.kind);
   }
   template <class F>
-  void for_each_field(F&& fn) { for_each_field(*this, fn); }
+  void for_each_field(F&& fn) {
+    for_each_field(*this, fn);
+  }
   template <class F>
-  void for_each_field(F&& fn) const { for_each_field(*this, fn); }
+  void for_each_field(F&& fn) const {
+    for_each_field(*this, fn);
+  }
 
   [[nodiscard]] std::size_t size() const { return x.size(); }
   void resize(std::size_t n) {
