@@ -312,6 +312,7 @@ struct StepFigures {
   double wall_ms = 0;                        // per step, around step()
   std::uint64_t pairs = 0;                   // neighbour pairs of the last search
   std::uint64_t builds = 0;                  // neighbour searches during the timed steps
+  double t_end = 0;                          // simulated time after the timed steps [s]
 };
 
 template <int Dim, class Real>
@@ -333,6 +334,7 @@ StepFigures time_steps(const nlohmann::json& j, const std::string& source, int w
   f.wall_ms = wall / steps;
   f.pairs = sim.search_stats().pairs;
   f.builds = t1.list_builds - t0.list_builds;
+  f.t_end = static_cast<double>(sim.time());
   return f;
 }
 
@@ -427,8 +429,8 @@ void run_bench_sph(const SphArgs& a) {
   std::printf(
       "\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
       "support 2 s, walls kept), Cell Indexing ==\n");
-  std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s\n", "model", "real", "fluid", "total",
-              "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s");
+  std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s %8s\n", "model", "real", "fluid", "total",
+              "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s", "t end s");
   for (std::size_t n : sizes) {
     const double spacing = std::cbrt(volume / static_cast<double>(n));
     for (const auto& model : models) {
@@ -441,10 +443,10 @@ void run_bench_sph(const SphArgs& a) {
         j["neighbors"]["method"] = "cell-index";
         const StepFigures f = time_scene(j, source, warmup, steps);
         const double step = f.neighbors_ms + f.dynamics_ms;
-        std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f\n", model.c_str(),
-                    prec.c_str(), f.fluid, f.total, f.neighbors_ms, f.dynamics_ms, f.wall_ms,
+        std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f\n",
+                    model.c_str(), prec.c_str(), f.fluid, f.total, f.neighbors_ms, f.dynamics_ms, f.wall_ms,
                     100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
-                    static_cast<double>(f.fluid) / (f.wall_ms * 1e3));
+                    static_cast<double>(f.fluid) / (f.wall_ms * 1e3), f.t_end);
         std::fflush(stdout);
         ::malloc_trim(0);
       }
