@@ -228,6 +228,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   auto& p = s.particles;
   if (r.has("boundary")) {
     auto br = r.child("boundary");
+    cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
     if (br.has("box")) {
       auto bx = br.child("box");
       const auto b = read_box<Dim>(bx);

@@ -116,6 +116,9 @@ struct SolverConfig {
   // reduced by a fixed fraction per contact, not by the normal impulse as dry Coulomb friction would) and
   // projection of the particle back onto the wall to prevent overshooting.
   std::vector<Plane<Dim, Real>> planes{};
+  // Boundary particles (walls, obstacles): free slip (pressure only) or no slip (also the fluid
+  // particle's viscosity against a wall at rest, as between two fluid particles).
+  bool no_slip = false;
   Real restitution = Real(0.2);
   Real friction = Real(0.1);
 

@@ -288,12 +288,13 @@ void Simulation<Dim, Real>::compute_forces_paper() {
           // A boundary particle acts as fluid with i's density (mirrored, so that its volume psi_b / rho_i
           // matches how i sees fluid neighbours; with rho0 instead a resting fluid is pushed off the
           // walls), i's pressure extrapolated to it (see mirrored_boundary_pressure) and i's colour (walls
-          // are neutral to interface tension). Walls are free-slip: no viscosity.
+          // are neutral to interface tension). No slip: eq. 8b against a particle at rest with i's mu.
           in.mj = p_.m[j];
           in.rhoj = in.rhoi;
           in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
           f += averaged_pressure_force(in, wp);
+          if (cfg_.no_slip) f += vel_i * (-vol_i * (in.mj / in.rhoi) * in.mui * wv.laplacian(in.r));
           if (any_tension_ && !csf) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
         }
       }
@@ -353,6 +354,11 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
           Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
           fp += boundary_pressure_force(in.xij, in.mi, in.rhoi, in.pi, pb, p_.m[j], wg);
+          if (cfg_.no_slip) {
+            // Monaghan's operator against a particle at rest with volume psi_b / rho_i and i's mu.
+            const Real q = dot(vel_i, in.xij) / (in.r * in.r + eps2);
+            fnp += wg.gradW(in.xij) * (visc_c * in.mui * vol_i * (p_.m[j] / in.rhoi) * q);
+          }
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, Real(1), wc);
         }
       }
