@@ -302,6 +302,7 @@ struct SphArgs {
   int steps = 20;
   int warmup = 3;
   int threads = 2;
+  double skin = -1;  // < 0: the scene's Verlet skin
   bool quick = false;
 };
 
@@ -388,6 +389,8 @@ void run_bench_sph(const SphArgs& a) {
   if (a.steps < 1) throw InputError("--steps: must be >= 1, got " + std::to_string(a.steps));
   if (a.warmup < 0) throw InputError("--warmup: must be >= 0, got " + std::to_string(a.warmup));
   if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
+  if (a.skin != -1 && !(a.skin >= 0 && a.skin <= 1))
+    throw InputError("--skin: must be in [0, 1], got " + std::to_string(a.skin));
   int steps = a.steps, warmup = a.warmup;
   if (a.quick) {
     sizes = {2000};
@@ -413,6 +416,7 @@ void run_bench_sph(const SphArgs& a) {
     for (Method m : methods) {
       nlohmann::json j = base;
       j["neighbors"]["method"] = std::string(method_name(m));
+      if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
       const StepFigures f = time_scene(j, source, warmup, steps);
       const double step = f.neighbors_ms + f.dynamics_ms;
       std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
@@ -441,6 +445,7 @@ void run_bench_sph(const SphArgs& a) {
         j["solver"]["model"] = model;
         j["precision"] = prec;
         j["neighbors"]["method"] = "cell-index";
+        if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
         const StepFigures f = time_scene(j, source, warmup, steps);
         const double step = f.neighbors_ms + f.dynamics_ms;
         std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f\n",
@@ -489,6 +494,8 @@ void register_bench(CLI::App& app, int& result) {
   sph->add_option("--steps", sargs->steps, "timed steps per case")->capture_default_str();
   sph->add_option("--warmup", sargs->warmup, "untimed steps first")->capture_default_str();
   sph->add_option("--threads", sargs->threads, "threads")->capture_default_str();
+  sph->add_option("--skin", sargs->skin,
+                  "Verlet skin (fraction of h) of every case; 0: a search every step (default: the scenes', 0.15)");
   sph->add_option("--methods", sargs->methods,
                   "comma-separated methods for Table 1 (default: all): " + method_names_joined(","));
   sph->add_option("--models", sargs->models, "models of the 3D runs: wcsph,paper")->capture_default_str();

@@ -129,6 +129,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"/solver/gravity", "[0, \"down\"]", "/solver/gravity", "down"},
                       BadCase{"/neighbors/method", "\"octree\"", "/neighbors/method", "octree"},
                       BadCase{"/neighbors/subdivision", "0", "/neighbors/subdivision", "out of range"},
+                      BadCase{"/neighbors/skin", "-0.1", "/neighbors/skin", "out of range"},
                       BadCase{"/time/dt", "0", "/time/dt", "out of range"},
                       BadCase{"/output/formats", "[\"obj\"]", "/output/formats/0", "obj"},
                       BadCase{"/boundary/box/damping", "0.5", "/boundary/box/damping", "out of range"},

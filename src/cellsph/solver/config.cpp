@@ -39,6 +39,7 @@ void SolverConfig<Dim, Real>::validate() const {
     non_negative(p + "sigma", phases[k].sigma);
   }
   non_negative("tension_threshold", tension_threshold);
+  non_negative("verlet_skin", verlet_skin);
   for (int a = 0; a < Dim; ++a)
     if (!std::isfinite(gravity[a])) bad("gravity[" + std::to_string(a) + "]", gravity[a], "must be finite");
   positive("time.dt", time.dt);

@@ -128,6 +128,9 @@ struct SolverConfig {
   V domain_lo{}, domain_hi{};
 
   SearchOptions search{};
+  // Verlet lists: the search runs at h (1 + verlet_skin) and its lists are kept until a particle has moved
+  // 0.45 of the skin. 0: a search every step. Results do not depend on it (pairs are re-filtered at h).
+  Real verlet_skin = Real(0.15);
   std::uint64_t seed = 1;
 
   static constexpr V gravity_default() {

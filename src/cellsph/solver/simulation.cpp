@@ -114,8 +114,8 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   init_boundary_weights();
   fluid_.clear();
   fluid_.reserve(fluid_count_);
-  // 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
-  skin_ = Real(0.15) * cfg_.support;
+  // Default 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
+  skin_ = cfg_.verlet_skin * cfg_.support;
   search_h_.assign(n, Real(0));
   for (std::size_t i = 0; i < n; ++i) {
     if (p_.kind[i] != kFluid) continue;
@@ -161,7 +161,7 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     lists_valid_ = false;
     return;
   }
-  if (lists_valid_) {
+  if (lists_valid_ && skin_ > 0) {
     Real d2 = 0;  // largest squared displacement since the lists were built (order-free: a maximum)
     const auto count = static_cast<std::int64_t>(fluid_.size());
 #pragma omp parallel for schedule(static) reduction(max : d2)
@@ -174,7 +174,7 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   }
   search_.build(std::span<const V>(p_.x), std::span<const Real>(search_h_));
   search_.find_all(nl_);
-  x_built_ = p_.x;
+  if (skin_ > 0) x_built_ = p_.x;
   lists_valid_ = true;
   ++timings_.list_builds;
 }

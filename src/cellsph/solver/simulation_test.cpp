@@ -430,6 +430,43 @@ TEST(Walls, NoSlipMatchesStokesFirstProblem) {
   }
 }
 
+// Verlet lists are a speed-up only: every pair is re-tested at h, so any skin (0: a search every step)
+// gives the same bits, while the number of searches drops with the skin.
+TEST(VerletLists, SkinChangesSearchCountNotResults) {
+  std::vector<std::vector<V2>> runs;
+  std::vector<std::uint64_t> builds;
+  for (double skin : {0.0, 0.15, 0.5}) {
+    const double s = 0.1, rho0 = 1000, c = 10 * std::sqrt(2 * 9.81 * 2);
+    SolverConfig<2, double> cfg;
+    cfg.model = Model::Wcsph;
+    cfg.search.method = Method::CellIndex;
+    cfg.density_kernel = KernelKind::CubicSpline;
+    cfg.pressure_kernel = KernelKind::CubicSpline;
+    cfg.support = 2 * s;
+    cfg.phases[0].rest_density = rho0;
+    cfg.phases[0].mass = rho0 * s * s;
+    cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / 8;
+    cfg.eos.kind = EosKind::Ratio;
+    cfg.eos.stiffness = rho0 * c * c;
+    cfg.eos.clamp_negative = true;
+    cfg.time.mode = TimeStepping::Courant;
+    cfg.time.dt_max = 1e-3;
+    cfg.verlet_skin = skin;
+    Particles<2, double> p;
+    add_block<2, double>(p, V2{{0, 0}}, V2{{1, 2}}, s, 0);
+    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{4, 3}}, s, 2, true, 0, rho0 * s * s);
+    Simulation<2, double> sim(cfg, std::move(p));
+    for (int k = 0; k < 300; ++k) sim.step();
+    runs.push_back(sim.particles().x);
+    builds.push_back(sim.timings().list_builds);
+  }
+  EXPECT_EQ(runs[0], runs[1]);
+  EXPECT_EQ(runs[0], runs[2]);
+  EXPECT_EQ(builds[0], 300u);
+  EXPECT_LT(builds[1], builds[0]);
+  EXPECT_LT(builds[2], builds[1]);
+}
+
 // The same conservation law in 3D and in single precision (a smoke test of the other instantiations).
 TEST(Solver3D, MomentumConservedBothModels) {
   for (Model model : {Model::PaperMultiphase, Model::Wcsph}) {
