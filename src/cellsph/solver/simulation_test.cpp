@@ -56,6 +56,28 @@ SolverConfig<2, double> base_config(Model model) {
   return c;
 }
 
+// 2D WCSPH water as the dam-break scenes set it up: cubic kernels, h = 2 spacings, ratio EOS with sound
+// speed c, clamped negative pressure, the artificial viscosity mu = rho0 alpha h c / (2 (d + 2)) with
+// alpha = 0.02, Courant steps.
+SolverConfig<2, double> wcsph_water(double s, double c) {
+  const double rho0 = 1000;
+  SolverConfig<2, double> cfg;
+  cfg.model = Model::Wcsph;
+  cfg.search.method = Method::CellIndex;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.pressure_kernel = KernelKind::CubicSpline;
+  cfg.support = 2 * s;
+  cfg.phases[0].rest_density = rho0;
+  cfg.phases[0].mass = rho0 * s * s;
+  cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / (2 * (2 + 2));
+  cfg.eos.kind = EosKind::Ratio;
+  cfg.eos.stiffness = rho0 * c * c;
+  cfg.eos.clamp_negative = true;
+  cfg.time.mode = TimeStepping::Courant;
+  cfg.time.dt_max = 1e-3;
+  return cfg;
+}
+
 template <int Dim, class Real>
 bool same_state(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
   bool same = a.size() == b.size();
@@ -242,21 +264,10 @@ TEST(Walls, BoxClampsAndDamps) {
 // about.
 TEST(Hydrostatic, TankSettlesToRhoGH) {
   const double s = 0.02, W = 0.2, H = 0.3, rho0 = 1000, g = 9.81;
-  SolverConfig<2, double> cfg;
-  cfg.model = Model::Wcsph;
+  // c: Mach 0.1 for the fastest free-fall speed
+  SolverConfig<2, double> cfg = wcsph_water(s, 10 * std::sqrt(2 * g * H));
   cfg.search.method = Method::AllPairs;
-  cfg.density_kernel = KernelKind::CubicSpline;
-  cfg.pressure_kernel = KernelKind::CubicSpline;
-  cfg.support = 2 * s;
-  cfg.phases[0].rest_density = rho0;
-  cfg.phases[0].mass = rho0 * s * s;
   cfg.phases[0].viscosity = 20;
-  const double c = 10 * std::sqrt(2 * g * H);  // Mach 0.1 for the fastest free-fall speed
-  cfg.eos.kind = EosKind::Ratio;
-  cfg.eos.stiffness = rho0 * c * c;
-  cfg.eos.clamp_negative = true;
-  cfg.time.mode = TimeStepping::Courant;
-  cfg.time.dt_max = 1e-3;
   cfg.domain_set = true;
   cfg.domain_lo = V2{{-0.1, -0.1}};
   cfg.domain_hi = V2{{W + 0.1, 2 * H}};
@@ -310,21 +321,8 @@ TEST(Hydrostatic, TankSettlesToRhoGH) {
 // claim.
 TEST(DamBreak, KoshizukaOkaSurgeFront) {
   const double s = 0.1, rho0 = 1000, g = 9.81, a = 1.0;
-  SolverConfig<2, double> cfg;
-  cfg.model = Model::Wcsph;
+  SolverConfig<2, double> cfg = wcsph_water(s, 10 * std::sqrt(2 * g * 2 * a));
   cfg.search.method = Method::AllPairs;
-  cfg.density_kernel = KernelKind::CubicSpline;
-  cfg.pressure_kernel = KernelKind::CubicSpline;
-  cfg.support = 2 * s;
-  const double c = 10 * std::sqrt(2 * g * 2 * a);
-  cfg.phases[0].rest_density = rho0;
-  cfg.phases[0].mass = rho0 * s * s;
-  cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / (2 * (2 + 2));
-  cfg.eos.kind = EosKind::Ratio;
-  cfg.eos.stiffness = rho0 * c * c;
-  cfg.eos.clamp_negative = true;
-  cfg.time.mode = TimeStepping::Courant;
-  cfg.time.dt_max = 1e-3;
   cfg.no_slip = true;
   cfg.domain_set = true;
   cfg.domain_lo = V2{{-0.5, -0.5}};
@@ -375,21 +373,10 @@ TEST(Walls, NoSlipMatchesStokesFirstProblem) {
   const double s = 0.02, rho0 = 1000, mu = 10, nu = mu / rho0, u0 = 0.05, t_end = 1.0;
   for (Model model : {Model::Wcsph, Model::PaperMultiphase}) {
     for (bool no_slip : {true, false}) {
-      SolverConfig<2, double> cfg;
+      SolverConfig<2, double> cfg = wcsph_water(s, 1.0);  // c = 1 m/s = 20 u0
       cfg.model = model;
-      cfg.search.method = Method::CellIndex;
-      cfg.density_kernel = KernelKind::CubicSpline;
-      cfg.pressure_kernel = KernelKind::CubicSpline;
-      cfg.support = 2 * s;
       cfg.gravity = V2{};
-      cfg.phases[0].rest_density = rho0;
-      cfg.phases[0].mass = rho0 * s * s;
       cfg.phases[0].viscosity = mu;
-      cfg.eos.kind = EosKind::Ratio;
-      cfg.eos.stiffness = rho0 * 1.0 * 1.0;  // c = 1 m/s = 20 u0
-      cfg.eos.clamp_negative = true;
-      cfg.time.mode = TimeStepping::Courant;
-      cfg.time.dt_max = 1e-3;
       cfg.no_slip = no_slip;
       Particles<2, double> p;
       // The block stops short of the end walls: it moves only u0 t = 5 cm, so it never meets them (a
@@ -436,21 +423,8 @@ TEST(VerletLists, SkinChangesSearchCountNotResults) {
   std::vector<std::vector<V2>> runs;
   std::vector<std::uint64_t> builds;
   for (double skin : {0.0, 0.15, 0.5}) {
-    const double s = 0.1, rho0 = 1000, c = 10 * std::sqrt(2 * 9.81 * 2);
-    SolverConfig<2, double> cfg;
-    cfg.model = Model::Wcsph;
-    cfg.search.method = Method::CellIndex;
-    cfg.density_kernel = KernelKind::CubicSpline;
-    cfg.pressure_kernel = KernelKind::CubicSpline;
-    cfg.support = 2 * s;
-    cfg.phases[0].rest_density = rho0;
-    cfg.phases[0].mass = rho0 * s * s;
-    cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / 8;
-    cfg.eos.kind = EosKind::Ratio;
-    cfg.eos.stiffness = rho0 * c * c;
-    cfg.eos.clamp_negative = true;
-    cfg.time.mode = TimeStepping::Courant;
-    cfg.time.dt_max = 1e-3;
+    const double s = 0.1, rho0 = 1000;
+    SolverConfig<2, double> cfg = wcsph_water(s, 10 * std::sqrt(2 * 9.81 * 2));
     cfg.verlet_skin = skin;
     Particles<2, double> p;
     add_block<2, double>(p, V2{{0, 0}}, V2{{1, 2}}, s, 0);
