@@ -528,7 +528,9 @@ Real Simulation<Dim, Real>::particle_dt(std::size_t i) const {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::build_work_sets() {
   const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
-  if (full_passes_) {
+  // When every particle is due (often: a uniform limit such as alpha h / c binds them all), the sets are
+  // the whole fluid and the marking pass would be pure overhead.
+  if (full_passes_ || due_list_.size() == fluid_.size()) {
     rho_set_ = fluid_;
     normal_set_ = csf ? fluid_ : IndexList{};
     return;
