@@ -131,9 +131,10 @@ void run_steps(const nlohmann::json& j, const std::string& source, StepsArgs a) 
   const auto& g = runs[0];
   const auto& pp = runs[1];
   std::printf(
-      "cellsph bench steps: %s, %dD, %d thread(s), to t = %g s, dt_max = %g s, max_level = %d, c = %g m/s%s\n",
+      "cellsph bench steps: %s, %dD, %d thread(s), to t = %g s, dt_max = %g s, max_level = %d, c = %g "
+      "m/s%s\n",
       source.c_str(), Dim, a.threads, a.end, a.dt_max, a.max_level, sound_speed,
-              a.stiffness > 0 ? (", stiffness " + std::to_string(a.stiffness)).c_str() : "");
+      a.stiffness > 0 ? (", stiffness " + std::to_string(a.stiffness)).c_str() : "");
   std::printf("%-17s %9s %13s %13s %13s %10s\n", "run", "steps", "force evals", "density evals",
               "normal evals", "wall ms");
   for (const auto& r : runs)
@@ -163,13 +164,15 @@ void run_steps(const nlohmann::json& j, const std::string& source, StepsArgs a) 
     for (std::size_t i = 0; i < np; ++i) {
       double d2 = 0;
       for (int d = 0; d < Dim; ++d) {
-        const double e = xa[i * Dim + static_cast<std::size_t>(d)] - xb[i * Dim + static_cast<std::size_t>(d)];
+        const double e =
+            xa[i * Dim + static_cast<std::size_t>(d)] - xb[i * Dim + static_cast<std::size_t>(d)];
         d2 += e * e;
       }
       dx += std::sqrt(d2);
     }
     std::printf("%8.3f %12.4f %12.4f %12.5f %12.5f %14.5f\n", pp.samples[s].t, g.samples[s].front,
-                pp.samples[s].front, g.samples[s].ke, pp.samples[s].ke, np ? dx / static_cast<double>(np) : 0.0);
+                pp.samples[s].front, g.samples[s].ke, pp.samples[s].ke,
+                np ? dx / static_cast<double>(np) : 0.0);
   }
 }
 

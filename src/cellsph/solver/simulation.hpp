@@ -118,9 +118,9 @@ class Simulation {
   std::vector<Real> rho0_;     // rest density per particle (from its phase)
   // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair
   // (the same expressions as before, so the values are bit for bit those computed per pair).
-  std::vector<Real> vol_;             // V_j = m_j / rho_j
-  std::vector<Real> prho2_;           // p_j / rho_j^2 (WCSPH symmetric pressure)
-  std::vector<V> xs_;  // per-particle steps: every position extrapolated to the global clock
+  std::vector<Real> vol_;    // V_j = m_j / rho_j
+  std::vector<Real> prho2_;  // p_j / rho_j^2 (WCSPH symmetric pressure)
+  std::vector<V> xs_;        // per-particle steps: every position extrapolated to the global clock
   // Per-particle steps, the work sets of a sub-step (ascending): the particles integrated (their forces
   // are evaluated), those whose CSF normals and whose densities those forces read.
   IndexList due_list_, normal_set_, rho_set_;

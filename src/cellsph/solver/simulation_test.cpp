@@ -471,7 +471,7 @@ PerParticleRun per_particle_column(TensionModel tension, bool full, int threads)
   cfg.phases[0].sigma = cfg.phases[1].sigma = 0.5;
   cfg.tension = tension;
   cfg.eos.kind = EosKind::Tait;
-  cfg.eos.stiffness = 300;  // c = 1.4 m/s: alpha h / c = 10 ms
+  cfg.eos.stiffness = 300;                                   // c = 1.4 m/s: alpha h / c = 10 ms
   cfg.phases[0].viscosity = cfg.phases[1].viscosity = 0.02;  // viscous limit 16 ms
   cfg.time.mode = TimeStepping::PerParticle;
   cfg.time.dt_max = 16e-3;
@@ -538,7 +538,8 @@ TEST(PerParticleSteps, WorkSetsAreBitIdenticalToFullPasses) {
     // Same forces evaluated, fewer densities (and normals).
     EXPECT_EQ(full.t.force_evals, sets.t.force_evals);
     EXPECT_LT(sets.t.density_evals, full.t.density_evals);
-    EXPECT_LT(sets.t.force_evals, full.t.density_evals) << "some sub-steps must advance only part of the fluid";
+    EXPECT_LT(sets.t.force_evals, full.t.density_evals)
+        << "some sub-steps must advance only part of the fluid";
     if (tension == TensionModel::Csf) {
       EXPECT_LT(sets.t.normal_evals, full.t.normal_evals);
     }
