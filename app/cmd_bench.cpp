@@ -507,6 +507,8 @@ void register_bench(CLI::App& app, int& result) {
     result = 0;
   });
 
+  add_bench_steps(*sub, result);
+
   sub->callback([sub, &result] {
     if (!sub->get_subcommands().empty()) return;
     std::cout << "Benchmarks (cellsph bench NAME --help for options):\n";

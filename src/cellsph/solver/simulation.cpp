@@ -1,6 +1,7 @@
 #include "cellsph/solver/simulation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <istream>
@@ -130,8 +131,14 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
 template <int Dim, class Real>
 template <class F>
 void Simulation<Dim, Real>::for_fluid(F&& f) const {
-  const std::uint32_t* idx = fluid_.data();
-  parallel_for(fluid_.size(), [&](std::size_t k) { f(static_cast<std::size_t>(idx[k])); });
+  for_each_of(fluid_, f);
+}
+
+template <int Dim, class Real>
+template <class F>
+void Simulation<Dim, Real>::for_each_of(const IndexList& set, F&& f) const {
+  const std::uint32_t* idx = set.data();
+  parallel_for(set.size(), [&](std::size_t k) { f(static_cast<std::size_t>(idx[k])); });
 }
 
 // Akinci et al. 2012: V_b = 1 / sum_k W_bk over boundary particles (self included), psi_b = rho0 V_b.
@@ -181,12 +188,13 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
 
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_density_pressure() {
+void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
+  timings_.density_evals += set.size();
   const bool number = cfg_.density == DensityFormulation::Number && cfg_.model == Model::PaperMultiphase;
   vol_.resize(p_.size());
   prho2_.resize(p_.size());
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
-    for_fluid([&](std::size_t i) {
+    for_each_of(set, [&](std::size_t i) {
       const V xi = p_.x[i];
       const Real hi2 = p_.h[i] * p_.h[i];
       Real rho = 0;
@@ -224,10 +232,11 @@ void Simulation<Dim, Real>::compute_density_pressure() {
 // CSF normals n_i = sum_j V_j (c_j - c_i) grad W_ij: the difference form vanishes exactly inside a phase.
 // Walls take the colour of the fluid particle, so they contribute nothing.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_normals() {
+void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
+  timings_.normal_evals += set.size();
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
   normal_.assign(p_.size(), V{});
-  for_fluid([&](std::size_t i) {
+  for_each_of(set, [&](std::size_t i) {
     V n{};
     const Real hi2 = p_.h[i] * p_.h[i];
     for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
@@ -241,16 +250,16 @@ void Simulation<Dim, Real>::compute_normals() {
 
 // Algorithm 1, lines 2-15: f_i = m_i g + eq. 8a + eq. 8b + eq. 9 (or CSF).
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_forces_paper() {
+void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const IndexList& normal_set) {
+  timings_.force_evals += set.size();
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
   const ViscosityKernel<Dim, Real> wv(cfg_.support);
   const Real lap_self = wc.laplacian(0);
   const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
   const Real thr2 = cfg_.tension_threshold * cfg_.tension_threshold;
-  if (csf) compute_normals();
+  if (csf) compute_normals(normal_set);
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wp) {
-    for_fluid([&](std::size_t i) {
-      if (!due_.empty() && !due_[i]) return;  // per-particle steps: keeps its last force
+    for_each_of(set, [&](std::size_t i) {
       const Real vol_i = p_.m[i] / p_.rho[i];
       V f = cfg_.gravity * p_.m[i];
       // The colour field includes particle i itself (its Laplacian does not vanish at r = 0), so that it
@@ -322,6 +331,7 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
   const Real h = cfg_.support;
   const Real eps2 = Real(0.01) * h * h;     // Monaghan's r^2 regulariser
   const Real visc_c = Real(2 * (Dim + 2));  // 2 (d + 2)
+  timings_.force_evals += fluid_.size();
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wg) {
     for_fluid([&](std::size_t i) {
       const Real vol_i = p_.m[i] / p_.rho[i];
@@ -516,11 +526,58 @@ Real Simulation<Dim, Real>::particle_dt(std::size_t i) const {
   return dt;
 }
 
+// Per-particle steps: the forces of a due particle i read, for every fluid neighbour j within h_i, its
+// density, pressure and volume (eq. 8a-c) and, with CSF, its normal, which reads the densities of j's own
+// neighbours. Densities are therefore needed on due + N(due) (+ N(N(due)) with CSF), normals on
+// due + N(due); anything more would be computed and never read. Marks only ever set bits, so the sets do
+// not depend on the order in which threads mark them.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::build_work_sets() {
+  const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
+  // When every particle is due (often: a uniform limit such as alpha h / c binds them all), the sets are
+  // the whole fluid and the marking pass would be pure overhead.
+  if (full_passes_ || due_list_.size() == fluid_.size()) {
+    rho_set_ = fluid_;
+    normal_set_ = csf ? fluid_ : IndexList{};
+    return;
+  }
+  constexpr std::uint8_t kRho = 1, kNormal = 2;
+  mark_.assign(p_.size(), 0);
+  auto mark_around = [&](const IndexList& from, std::uint8_t bits) {
+    for_each_of(from, [&](std::size_t i) {
+      std::atomic_ref<std::uint8_t>(mark_[i]).fetch_or(bits, std::memory_order_relaxed);
+      const V xi = p_.x[i];
+      const Real hi2 = p_.h[i] * p_.h[i];
+      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        const std::uint32_t j = *it;
+        if (p_.kind[j] != kFluid || distance2(xi, p_.x[j]) > hi2) continue;  // the passes' own test
+        std::atomic_ref<std::uint8_t>(mark_[j]).fetch_or(bits, std::memory_order_relaxed);
+      }
+    });
+  };
+  auto collect = [&](IndexList& out, std::uint8_t bit) {
+    out.clear();
+    for (const std::uint32_t i : fluid_)
+      if (mark_[i] & bit) out.push_back(i);
+  };
+  if (csf) {
+    mark_around(due_list_, static_cast<std::uint8_t>(kRho | kNormal));
+    collect(normal_set_, kNormal);
+    mark_around(normal_set_, kRho);
+  } else {
+    mark_around(due_list_, kRho);
+    normal_set_.clear();
+  }
+  collect(rho_set_, kRho);
+}
+
 // Per-particle power-of-two steps (Desbrun 1996; paper eq. 12-13). Times are integer ticks of
 // dt_max / 2^max_level, so "is particle i due" is an exact comparison. Each step:
 //  1. the global clock T is the smallest particle time; particles with tick == T are due;
-//  2. every position is extrapolated to T (x_j + (T - t_j) v_j), neighbours and densities are computed
-//     for all, forces only for the due particles;
+//  2. every position is extrapolated to T (x_j + (T - t_j) v_j) and the neighbour lists kept up to date
+//     for all; forces are evaluated for the due particles only, densities (and CSF normals) only where
+//     those forces read them (build_work_sets), so a sub-step costs in proportion to the particles it
+//     advances;
 //  3. a due particle picks its level from eq. 12 (coarsening only onto a multiple of the coarser step),
 //     gets the position correction of a step change, then the leap-frog kick and drift of Algorithm 1.
 // Step change: the stored v = v(t - dt_old/2) must become v(t + dt_new/2) = v + a (dt_old + dt_new)/2
@@ -531,20 +588,16 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::step_per_particle() {
   const int L = cfg_.time.max_level;
   const Real unit = cfg_.time.dt_max / static_cast<Real>(std::int64_t{1} << L);
-  const std::size_t n = p_.size();
   std::int64_t T = std::numeric_limits<std::int64_t>::max();
-  for (std::size_t i = 0; i < n; ++i)
-    if (p_.kind[i] == kFluid) T = std::min(T, p_.tick[i]);
+  for (const std::uint32_t i : fluid_) T = std::min(T, p_.tick[i]);
   if (T == std::numeric_limits<std::int64_t>::max()) T = 0;
 
   Stopwatch sw;
-  due_.assign(n, 0);
-  xs_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    xs_[i] = p_.x[i];
-    if (p_.kind[i] != kFluid) continue;
+  due_list_.clear();
+  xs_ = p_.x;
+  for (const std::uint32_t i : fluid_) {
     if (p_.tick[i] == T)
-      due_[i] = 1;
+      due_list_.push_back(i);
     else
       xs_[i] += p_.v[i] * (static_cast<Real>(T - p_.tick[i]) * unit);
   }
@@ -552,16 +605,16 @@ void Simulation<Dim, Real>::step_per_particle() {
   compute_neighbors();
   timings_.neighbors += sw.ms();
   sw.reset();
-  compute_density_pressure();
-  compute_forces_paper();
+  build_work_sets();
+  compute_density_pressure(rho_set_);
+  compute_forces_paper(due_list_, normal_set_);
   std::swap(p_.x, xs_);
   timings_.forces += sw.ms();
 
   sw.reset();
   const bool started = leapfrog_started_;
   const auto corr = cfg_.time.correction;
-  parallel_for(n, [&](std::size_t i) {
-    if (!due_[i]) return;
+  for_each_of(due_list_, [&](std::size_t i) {
     int level = 0;
     const Real want = particle_dt(i);
     while (level < L && cfg_.time.dt_max / static_cast<Real>(std::int64_t{1} << level) > want) ++level;
@@ -587,13 +640,11 @@ void Simulation<Dim, Real>::step_per_particle() {
   apply_walls();
   check_state();
   std::int64_t next = std::numeric_limits<std::int64_t>::max();
-  for (std::size_t i = 0; i < n; ++i)
-    if (p_.kind[i] == kFluid) next = std::min(next, p_.tick[i]);
+  for (const std::uint32_t i : fluid_) next = std::min(next, p_.tick[i]);
   if (next == std::numeric_limits<std::int64_t>::max()) next = T + (std::int64_t{1} << L);
   last_dt_ = static_cast<Real>(next - T) * unit;
   time_ = static_cast<Real>(next) * unit;
   ++steps_;
-  due_.clear();
   timings_.integration += sw.ms();
 }
 
@@ -608,9 +659,9 @@ void Simulation<Dim, Real>::step() {
   timings_.neighbors += sw.ms();
 
   sw.reset();
-  compute_density_pressure();
+  compute_density_pressure(fluid_);
   if (cfg_.model == Model::PaperMultiphase)
-    compute_forces_paper();
+    compute_forces_paper(fluid_, fluid_);
   else
     compute_forces_wcsph();
   timings_.forces += sw.ms();

@@ -27,6 +27,11 @@ struct StepTimings {
   double forces = 0;              // density, pressure, forces
   double integration = 0;         // time step choice, integration, walls, stability check
   std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
+  // Work done, in particles (summed over steps): a global step evaluates every fluid particle once; a
+  // per-particle sub-step only the particles it integrates and those their forces read.
+  std::uint64_t density_evals = 0;  // densities and pressures (eq. 7 + equation of state)
+  std::uint64_t normal_evals = 0;   // CSF colour normals
+  std::uint64_t force_evals = 0;    // forces (eq. 8-9)
 };
 
 template <int Dim, class Real>
@@ -70,17 +75,30 @@ class Simulation {
   void save_state(std::ostream& out) const;
   void load_state(std::istream& in);
 
+  // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
+  // fluid particle in every sub-step, as before the work sets existed. Results are bit-identical either
+  // way (only the densities of particles no force reads differ: with the work sets they keep the value
+  // of their last evaluation); only the cost changes.
+  void set_full_passes(bool on) { full_passes_ = on; }
+
   static constexpr std::uint32_t kStateVersion = 2;  // 2: the per-particle "tick" field
 
  private:
   // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
   // fluid rows, so boundary particles are then searched with support 0.
   void compute_neighbors(bool boundary_rows = false);
+  using IndexList = std::vector<std::uint32_t>;
   template <class F>
   void for_fluid(F&& f) const;
-  void compute_density_pressure();
-  void compute_forces_paper();
-  void compute_normals();
+  template <class F>
+  void for_each_of(const IndexList& set, F&& f) const;
+  // The passes run over a set of fluid particles (ascending indices): fluid_ for a global step.
+  void compute_density_pressure(const IndexList& set);
+  // normal_set: the particles whose CSF normals the forces of `set` read.
+  void compute_forces_paper(const IndexList& set, const IndexList& normal_set);
+  void compute_normals(const IndexList& set);
+  // Per-particle steps: from due_list_, the particles whose normals and densities the forces read.
+  void build_work_sets();
   void compute_forces_wcsph();
   Real choose_dt() const;
   void integrate_paper(Real dt);
@@ -100,10 +118,14 @@ class Simulation {
   std::vector<Real> rho0_;     // rest density per particle (from its phase)
   // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair
   // (the same expressions as before, so the values are bit for bit those computed per pair).
-  std::vector<Real> vol_;             // V_j = m_j / rho_j
-  std::vector<Real> prho2_;           // p_j / rho_j^2 (WCSPH symmetric pressure)
-  std::vector<V> xs_;                 // per-particle steps: every position extrapolated to the global clock
-  std::vector<std::uint8_t> due_;     // per-particle steps: 1 for the particles integrated this step
+  std::vector<Real> vol_;    // V_j = m_j / rho_j
+  std::vector<Real> prho2_;  // p_j / rho_j^2 (WCSPH symmetric pressure)
+  std::vector<V> xs_;        // per-particle steps: every position extrapolated to the global clock
+  // Per-particle steps, the work sets of a sub-step (ascending): the particles integrated (their forces
+  // are evaluated), those whose CSF normals and whose densities those forces read.
+  IndexList due_list_, normal_set_, rho_set_;
+  std::vector<std::uint8_t> mark_;  // per particle: 1 density needed, 2 normal needed
+  bool full_passes_ = false;
   std::vector<std::uint32_t> fluid_;  // indices of the fluid particles, ascending (kinds never change)
   // Verlet lists: the step's CSR lists hold the pairs within h + skin of the positions x_built_ and are
   // kept while no particle has moved more than 0.45 skin since (then every pair within h now was

@@ -527,6 +527,113 @@ TEST(PerParticleSteps, CheckpointResumeIsBitIdentical) {
   EXPECT_EQ(full.time(), resumed.time());
 }
 
+// Per-particle steps evaluate densities (and CSF normals) only where the due particles' forces read them.
+// That must be a pure optimisation: the reference is the same scene with every density and normal
+// computed in every sub-step (set_full_passes, the computation before the work sets), run in the same
+// process. A two-phase column collapsing in a tank of boundary particles with a plane floor, interface
+// tension of both kinds, a low sound speed so that eq. 12's velocity and force terms spread the particles
+// over several levels.
+struct PerParticleRun {
+  Particles<2, double> p;
+  StepTimings t;
+  double time = 0;
+  std::vector<std::uint8_t> last_due;  // 1 for the particles advanced by the last sub-step
+  int levels = 0;                      // distinct levels seen
+};
+
+PerParticleRun per_particle_column(TensionModel tension, bool full, int threads) {
+  auto cfg = base_config(Model::PaperMultiphase);
+  cfg.gravity = SolverConfig<2, double>::gravity_default();
+  cfg.phases.push_back(cfg.phases[0]);
+  cfg.phases[1].rest_density = 1500;
+  cfg.phases[1].mass = 1500 * 0.02 * 0.02;
+  cfg.phases[1].color = 2;
+  cfg.phases[0].sigma = cfg.phases[1].sigma = 0.5;
+  cfg.tension = tension;
+  cfg.eos.kind = EosKind::Tait;
+  cfg.eos.stiffness = 300;                                   // c = 1.4 m/s: alpha h / c = 10 ms
+  cfg.phases[0].viscosity = cfg.phases[1].viscosity = 0.02;  // viscous limit 16 ms
+  cfg.time.mode = TimeStepping::PerParticle;
+  cfg.time.dt_max = 16e-3;
+  cfg.time.max_level = 6;
+  cfg.search.method = Method::CellIndex;
+  cfg.planes.push_back({V2{{0, 1}}, 0.0});
+  Particles<2, double> p;
+  const double s = 0.02;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{0.16, 0.3}}, s, 0);
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-2, 2);  // alpha h / |v| from 5 ms up: several levels
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.x[i][1] > 0.2) p.phase[i] = 1;
+    p.v[i] = V2{{u(gen), u(gen)}};
+  }
+  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{0.5, 0.4}}, s, 2, true, 0, 1000 * s * s);
+  ScopedThreads use(threads);
+  Simulation<2, double> sim(cfg, p);
+  sim.set_full_passes(full);
+  PerParticleRun r;
+  std::vector<int> seen(cfg.time.max_level + 1, 0);
+  for (int k = 0; k < 150; ++k) {
+    const auto ticks = sim.particles().tick;
+    sim.step();
+    r.last_due.assign(ticks.size(), 0);
+    for (std::size_t i = 0; i < ticks.size(); ++i) {
+      r.last_due[i] = ticks[i] != sim.particles().tick[i];
+      if (sim.particles().kind[i] == 0) seen[static_cast<std::size_t>(sim.particles().level[i])] = 1;
+    }
+  }
+  r.p = sim.particles();
+  r.t = sim.timings();
+  r.time = sim.time();
+  for (int v : seen) r.levels += v;
+  return r;
+}
+
+TEST(PerParticleSteps, WorkSetsAreBitIdenticalToFullPasses) {
+  for (auto tension : {TensionModel::Paper, TensionModel::Csf}) {
+    SCOPED_TRACE(std::string(tension_model_name(tension)));
+    const auto full = per_particle_column(tension, true, 1);
+    const auto sets = per_particle_column(tension, false, 1);
+    EXPECT_GE(sets.levels, 2) << "the particles must spread over levels for the sets to be partial";
+    EXPECT_EQ(full.time, sets.time);
+    // Integrated state: every particle, bit for bit.
+    auto same = [](const auto& a, const auto& b) {
+      return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+    };
+    EXPECT_TRUE(same(full.p.x, sets.p.x));
+    EXPECT_TRUE(same(full.p.v, sets.p.v));
+    EXPECT_TRUE(same(full.p.f, sets.p.f));
+    EXPECT_TRUE(same(full.p.level, sets.p.level));
+    EXPECT_TRUE(same(full.p.tick, sets.p.tick));
+    // Densities of the particles the last sub-step advanced (computed by both); the others keep, with the
+    // work sets, the density of their last evaluation.
+    std::size_t compared = 0;
+    for (std::size_t i = 0; i < full.p.size(); ++i) {
+      if (!sets.last_due[i]) continue;
+      ++compared;
+      EXPECT_EQ(std::memcmp(&full.p.rho[i], &sets.p.rho[i], sizeof(double)), 0) << "particle " << i;
+      EXPECT_EQ(std::memcmp(&full.p.p[i], &sets.p.p[i], sizeof(double)), 0) << "particle " << i;
+    }
+    EXPECT_GT(compared, 0u);
+    // Same forces evaluated, fewer densities (and normals).
+    EXPECT_EQ(full.t.force_evals, sets.t.force_evals);
+    EXPECT_LT(sets.t.density_evals, full.t.density_evals);
+    EXPECT_LT(sets.t.force_evals, full.t.density_evals)
+        << "some sub-steps must advance only part of the fluid";
+    if (tension == TensionModel::Csf) {
+      EXPECT_LT(sets.t.normal_evals, full.t.normal_evals);
+    }
+    std::cout << "[per-particle] " << tension_model_name(tension) << ": " << full.t.force_evals
+              << " force evaluations; densities " << sets.t.density_evals << " (sets) vs "
+              << full.t.density_evals << " (full), normals " << sets.t.normal_evals << " vs "
+              << full.t.normal_evals << ", " << sets.levels << " levels\n";
+    // Thread count: the marks are set concurrently, the results must not depend on it.
+    const auto two = per_particle_column(tension, false, 2);
+    EXPECT_TRUE(same_state(sets.p, two.p));
+    EXPECT_EQ(sets.t.density_evals, two.t.density_evals);
+  }
+}
+
 TEST(PerParticleSteps, RejectedForWcsph) {
   auto cfg = base_config(Model::Wcsph);
   cfg.time.mode = TimeStepping::PerParticle;
