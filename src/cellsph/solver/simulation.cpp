@@ -274,7 +274,10 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
       const Real hi2 = p_.h[i] * p_.h[i];
       const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
       const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
-      Real kappa = 0;  // CSF: -div(n / |n|) over neighbours with a defined normal
+      // CSF: kappa = -div(n / |n|) over neighbours with a defined normal, divided by their kernel sum
+      // (Morris 2000): the sum alone takes n_j = n_i for the others (more than one support from the
+      // interface) and underestimated the curvature by 17% (Laplace jump) whatever the resolution.
+      Real kappa = 0, wsum = vol_i * wc.W2(0);
       const V vel_i = p_.v[i];
       for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
         const std::uint32_t j = *it;
@@ -290,6 +293,7 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
           if (csf_i && norm2(normal_[j]) > thr2 && norm2(normal_[j]) > 0) {
             const V nhat_j = normal_[j] / norm(normal_[j]);
             kappa -= vol_[j] * dot(nhat_j - nhat_i, wc.gradW(in.xij));
+            wsum += vol_[j] * wc.W2(in.r * in.r);
           } else if (any_tension_ && !csf) {
             accumulate_color(cf, in.xij, in.r, vol_[j], p_.color[j], wc);
           }
@@ -309,7 +313,7 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
       }
       if (csf_i) {
         const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-        f += normal_[i] * (ph.sigma * kappa * vol_i);
+        f += normal_[i] * (ph.sigma * kappa / wsum * vol_i);
       } else if (any_tension_ && !csf) {
         // Eq. 9 has the units of a force density (sigma [N/m] times a curvature of C [1/m^2]); by the
         // paper's own eq. 6 the particle's force is V_i times it. Taken literally as a force it gives
