@@ -133,6 +133,29 @@ TEST(CliRun, ResumeExtendsAFinishedRunAndRestartsWithoutCheckpoint) {
   EXPECT_EQ(read_file(dir / "whole" / "frames.csv"), read_file(dir / "ext" / "frames.csv"));
 }
 
+TEST(CliRun, ResumeFromADamagedOrOldCheckpointExitsWithCode2NamingTheFile) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  auto r = run_cli(
+      dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "o") + " --quiet --format csv --until 0.04");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto ckpt = dir / "o" / "checkpoint.bin";
+  std::string bytes = read_file(ckpt);
+  ASSERT_EQ(bytes.substr(0, 8), "CSPHCKPT");
+  const std::size_t at = bytes.size() - 9;  // the last particle's kind, just before the checksum
+  bytes[at] = static_cast<char>(bytes[at] ^ 1);
+  write_file(ckpt, bytes);
+  r = run_cli(dir, "run --resume " + q(dir / "o") + " --until 0.1 --quiet");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(ckpt.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("checksum mismatch"), std::string::npos) << r.err;
+  // The format of earlier builds (magic CSPHRUN1) is named as such.
+  write_file(ckpt, std::string("CSPHRUN1") + std::string(64, '\0'));
+  r = run_cli(dir, "run --resume " + q(dir / "o") + " --until 0.1 --quiet");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("earlier cellsph"), std::string::npos) << r.err;
+}
+
 TEST(CliRun, SameResultWithEveryNeighbourMethod) {
   TempDir dir;
   write_file(dir / "tiny.json", kTiny);

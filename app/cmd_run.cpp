@@ -18,6 +18,7 @@
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/io/frame_output.hpp"
+#include "cellsph/io/simulation_checkpoint.hpp"
 #include "cellsph/render/renderer.hpp"
 #include "cellsph/render/video.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
@@ -34,8 +35,11 @@ namespace {
 constexpr const char* kDefaultScene = "dam-break-2d";
 constexpr const char* kRunFile = "run.json";
 constexpr const char* kCheckpointFile = "checkpoint.bin";
-constexpr std::uint32_t kRunCheckpointVersion = 1;
-constexpr char kRunMagic[8] = {'C', 'S', 'P', 'H', 'R', 'U', 'N', '1'};
+// The checkpoint (io/simulation_checkpoint.hpp) carries the loop state below as its caller data:
+// kLoopStateVersion, then the next frame number (u32 + u64, native = little endian).
+constexpr std::uint32_t kLoopStateVersion = 1;
+// The magic of the checkpoints of earlier builds (their own format, before io/checkpoint was used).
+constexpr char kOldRunMagic[8] = {'C', 'S', 'P', 'H', 'R', 'U', 'N', '1'};
 
 struct RunOptions {
   std::string scene;
@@ -57,7 +61,35 @@ struct RunOptions {
 // The state of the run loop that a checkpoint stores besides the simulation.
 struct LoopState {
   std::uint64_t next_frame = 0;
+
+  [[nodiscard]] std::string encode() const {
+    std::string s(sizeof kLoopStateVersion + sizeof next_frame, '\0');
+    std::memcpy(s.data(), &kLoopStateVersion, sizeof kLoopStateVersion);
+    std::memcpy(s.data() + sizeof kLoopStateVersion, &next_frame, sizeof next_frame);
+    return s;
+  }
+  void decode(const std::string& s, const std::filesystem::path& file) {
+    std::uint32_t version = 0;
+    if (s.size() == sizeof version + sizeof next_frame) std::memcpy(&version, s.data(), sizeof version);
+    if (version != kLoopStateVersion)
+      throw InputError("checkpoint '" + file.string() + "': run loop state of " + std::to_string(s.size()) +
+                       " bytes, version " + std::to_string(version) + " (this cellsph reads version " +
+                       std::to_string(kLoopStateVersion) + ", " +
+                       std::to_string(sizeof version + sizeof next_frame) + " bytes)");
+    std::memcpy(&next_frame, s.data() + sizeof version, sizeof next_frame);
+  }
 };
+
+// Earlier builds wrote checkpoint.bin in a format of their own: say so rather than "bad magic".
+void reject_old_checkpoint(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[sizeof kOldRunMagic] = {};
+  in.read(magic, sizeof magic);
+  if (in && std::memcmp(magic, kOldRunMagic, sizeof magic) == 0)
+    throw InputError("checkpoint '" + file.string() +
+                     "': written by an earlier cellsph in a format this one does not read (CSPHRUN1); "
+                     "run the scene again");
+}
 
 std::string fmt(const char* f, double v) {
   char buf[64];
@@ -109,19 +141,8 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     resuming = false;
   }
   if (resuming) {
-    std::ifstream in(ckpt_path, std::ios::binary);
-    if (!in) throw InputError(ckpt_path.string() + ": cannot read the checkpoint");
-    char magic[8];
-    std::uint32_t version = 0;
-    in.read(magic, 8);
-    in.read(reinterpret_cast<char*>(&version), sizeof version);
-    in.read(reinterpret_cast<char*>(&loop.next_frame), sizeof loop.next_frame);
-    if (!in || std::memcmp(magic, kRunMagic, 8) != 0)
-      throw InputError(ckpt_path.string() + ": not a cellsph run checkpoint");
-    if (version != kRunCheckpointVersion)
-      throw InputError(ckpt_path.string() + ": checkpoint format version " + std::to_string(version) +
-                       ", this cellsph reads version " + std::to_string(kRunCheckpointVersion));
-    sim.load_state(in);
+    reject_old_checkpoint(ckpt_path);
+    loop.decode(read_simulation_checkpoint(ckpt_path, sim), ckpt_path);
     frames.resume(loop.next_frame);
   }
 
@@ -148,14 +169,7 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   const double t_at_start = double(sim.time());
   const double frame_dt = 1.0 / os.fps;
 
-  auto write_checkpoint = [&] {
-    AtomicFile f(ckpt_path, true);
-    f.stream().write(kRunMagic, 8);
-    f.stream().write(reinterpret_cast<const char*>(&kRunCheckpointVersion), sizeof kRunCheckpointVersion);
-    f.stream().write(reinterpret_cast<const char*>(&loop.next_frame), sizeof loop.next_frame);
-    sim.save_state(f.stream());
-    f.commit();
-  };
+  auto write_checkpoint = [&] { write_simulation_checkpoint(sim, loop.encode(), ckpt_path); };
   auto write_frame = [&] {
     Stopwatch sw;
     const double t = double(sim.time());

@@ -24,20 +24,6 @@ namespace {
 constexpr std::uint8_t kFluid = static_cast<std::uint8_t>(ParticleKind::Fluid);
 constexpr std::uint8_t kBoundary = static_cast<std::uint8_t>(ParticleKind::Boundary);
 
-template <class T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <class T>
-T get(std::istream& in, const char* what) {
-  T v{};
-  in.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!in) throw InputError(std::string("checkpoint: truncated while reading ") + what);
-  return v;
-}
-
-constexpr char kMagic[8] = {'C', 'S', 'P', 'H', 'S', 'T', 'A', 'T'};
-
 }  // namespace
 
 template <int Dim, class Real>
@@ -713,93 +699,23 @@ Real Simulation<Dim, Real>::total_mass() const {
   return s;
 }
 
-// Layout: magic, version, Dim, sizeof(Real), particle count, integrator state, then for every field of
-// the field list: name, element size, element count, raw bytes.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::save_state(std::ostream& out) const {
-  out.write(kMagic, sizeof kMagic);
-  put(out, kStateVersion);
-  put(out, std::int32_t{Dim});
-  put(out, static_cast<std::uint32_t>(sizeof(Real)));
-  put(out, static_cast<std::uint64_t>(p_.size()));
-  put(out, time_);
-  put(out, last_dt_);
-  put(out, steps_);
-  put(out, static_cast<std::uint8_t>(leapfrog_started_));
-  std::uint32_t nfields = 0;
-  p_.for_each_field([&](std::string_view, const auto&) { ++nfields; });
-  put(out, nfields);
-  p_.for_each_field([&](std::string_view name, const auto& field) {
-    using T = typename std::decay_t<decltype(field)>::value_type;
-    put(out, static_cast<std::uint32_t>(name.size()));
-    out.write(name.data(), static_cast<std::streamsize>(name.size()));
-    put(out, static_cast<std::uint32_t>(sizeof(T)));
-    put(out, static_cast<std::uint64_t>(field.size()));
-    out.write(reinterpret_cast<const char*>(field.data()),
-              static_cast<std::streamsize>(field.size() * sizeof(T)));
-  });
-  if (!out) throw InputError("checkpoint: write failed");
-}
-
-template <int Dim, class Real>
-void Simulation<Dim, Real>::load_state(std::istream& in) {
-  char magic[sizeof kMagic];
-  in.read(magic, sizeof magic);
-  if (!in || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw InputError("checkpoint: not a cellsph state file (bad magic)");
-  const auto version = get<std::uint32_t>(in, "version");
-  if (version != kStateVersion) {
-    throw InputError("checkpoint: format version " + std::to_string(version) + ", this build reads " +
-                     std::to_string(kStateVersion));
-  }
-  const auto dim = get<std::int32_t>(in, "dimension");
-  const auto real = get<std::uint32_t>(in, "precision");
-  if (dim != Dim || real != sizeof(Real)) {
-    throw InputError("checkpoint: written for " + std::to_string(dim) + "D with " + std::to_string(real) +
-                     "-byte reals, this run is " + std::to_string(Dim) + "D with " +
-                     std::to_string(sizeof(Real)) + "-byte reals");
-  }
-  const auto n = get<std::uint64_t>(in, "particle count");
+void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state,
+                                    const std::string& source) {
+  const std::size_t n = particles.size();
   if (n != p_.size()) {
-    throw InputError("checkpoint: holds " + std::to_string(n) + " particles, the scene has " +
+    throw InputError(source + ": holds " + std::to_string(n) + " particles, the scene has " +
                      std::to_string(p_.size()));
   }
-  const Real t = get<Real>(in, "time");
-  const Real ldt = get<Real>(in, "last dt");
-  const auto st = get<std::uint64_t>(in, "steps");
-  const auto started = get<std::uint8_t>(in, "integrator state");
-  const auto nfields = get<std::uint32_t>(in, "field count");
-  std::uint32_t expected = 0;
-  p_.for_each_field([&](std::string_view, const auto&) { ++expected; });
-  if (nfields != expected) {
-    throw InputError("checkpoint: has " + std::to_string(nfields) + " fields, this build has " +
-                     std::to_string(expected));
-  }
-  Particles<Dim, Real> loaded = p_;
-  loaded.for_each_field([&](std::string_view name, auto& field) {
-    using T = typename std::decay_t<decltype(field)>::value_type;
-    const auto len = get<std::uint32_t>(in, "field name");
-    std::string got(len, '\0');
-    in.read(got.data(), len);
-    if (!in || got != name)
-      throw InputError("checkpoint: expected field '" + std::string(name) + "', found '" + got + "'");
-    const auto size = get<std::uint32_t>(in, "element size");
-    const auto count = get<std::uint64_t>(in, "element count");
-    if (size != sizeof(T) || count != n)
-      throw InputError("checkpoint: field '" + std::string(name) + "' has a wrong element size or count");
-    field.resize(count);
-    in.read(reinterpret_cast<char*>(field.data()), static_cast<std::streamsize>(count * sizeof(T)));
-    if (!in) throw InputError("checkpoint: truncated in field '" + std::string(name) + "'");
-  });
   for (std::size_t i = 0; i < n; ++i) {
-    if (loaded.phase[i] < 0 || static_cast<std::size_t>(loaded.phase[i]) >= cfg_.phases.size() ||
-        loaded.kind[i] > kBoundary) {
-      throw InputError("checkpoint: particle " + std::to_string(i) + " has phase " +
-                       std::to_string(loaded.phase[i]) + " / kind " + std::to_string(int(loaded.kind[i])) +
-                       ", not in this scene's tables");
+    if (particles.phase[i] < 0 || static_cast<std::size_t>(particles.phase[i]) >= cfg_.phases.size() ||
+        particles.kind[i] > kBoundary) {
+      throw InputError(source + ": particle " + std::to_string(i) + " has phase " +
+                       std::to_string(particles.phase[i]) + " / kind " +
+                       std::to_string(int(particles.kind[i])) + ", not in this scene's tables");
     }
   }
-  p_ = std::move(loaded);
+  p_ = std::move(particles);
   fluid_.clear();
   for (std::size_t i = 0; i < p_.size(); ++i) {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
@@ -809,10 +725,10 @@ void Simulation<Dim, Real>::load_state(std::istream& in) {
   }
   fluid_count_ = fluid_.size();
   lists_valid_ = false;
-  time_ = t;
-  last_dt_ = ldt;
-  steps_ = st;
-  leapfrog_started_ = started != 0;
+  time_ = state.time;
+  last_dt_ = state.last_dt;
+  steps_ = state.steps;
+  leapfrog_started_ = state.leapfrog_started;
 }
 
 template class Simulation<2, float>;

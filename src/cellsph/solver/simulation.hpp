@@ -11,7 +11,7 @@
 // Determinism: every per-particle sum runs over the canonical CSR row (ascending neighbour index) on one
 // thread, so results are bit-identical for any thread count and any neighbour method.
 #include <cstdint>
-#include <iosfwd>
+#include <string>
 #include <vector>
 
 #include "cellsph/core/vec.hpp"
@@ -32,6 +32,15 @@ struct StepTimings {
   std::uint64_t density_evals = 0;  // densities and pressures (eq. 7 + equation of state)
   std::uint64_t normal_evals = 0;   // CSF colour normals
   std::uint64_t force_evals = 0;    // forces (eq. 8-9)
+};
+
+// What step() carries from one step to the next besides the particles.
+template <class Real>
+struct IntegratorState {
+  Real time = 0;                  // simulated time [s]
+  Real last_dt = 0;               // the last step's dt (the paper model's leap-frog needs it)
+  std::uint64_t steps = 0;        // steps taken
+  bool leapfrog_started = false;  // paper model: particles().v holds v(t - dt/2)
 };
 
 template <int Dim, class Real>
@@ -69,19 +78,22 @@ class Simulation {
   [[nodiscard]] Real kinetic_energy() const;
   [[nodiscard]] Real total_mass() const;
 
-  // Checkpoints: binary, versioned, every field of the field list plus the integrator state. Loading
-  // into a Simulation built from the same config and continuing gives results bit-identical to an
-  // uninterrupted run. load_state throws InputError on a mismatch (field, dimension, precision, count).
-  void save_state(std::ostream& out) const;
-  void load_state(std::istream& in);
+  // Checkpoints (written by io/simulation_checkpoint.hpp): the particles (every field of the field list)
+  // and this integrator state. Restoring both into a Simulation built from the same config and
+  // continuing gives results bit-identical to an uninterrupted run.
+  [[nodiscard]] IntegratorState<Real> integrator_state() const {
+    return {time_, last_dt_, steps_, leapfrog_started_};
+  }
+  // Replaces the particles and the integrator state. Throws InputError, prefixed with `source` (the
+  // checkpoint file), when the particles do not fit this simulation: count, phase or kind not in its
+  // tables. The simulation is untouched on error.
+  void restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state, const std::string& source);
 
   // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
   // fluid particle in every sub-step, as before the work sets existed. Results are bit-identical either
   // way (only the densities of particles no force reads differ: with the work sets they keep the value
   // of their last evaluation); only the cost changes.
   void set_full_passes(bool on) { full_passes_ = on; }
-
-  static constexpr std::uint32_t kStateVersion = 2;  // 2: the per-particle "tick" field
 
  private:
   // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
@@ -140,7 +152,7 @@ class Simulation {
   bool any_tension_ = false;
   std::size_t fluid_count_ = 0;
 
-  // Integrator state (saved in checkpoints).
+  // Integrator state (integrator_state(), restore()).
   Real time_ = 0;
   Real last_dt_ = 0;
   std::uint64_t steps_ = 0;

@@ -159,12 +159,12 @@ TEST_P(BothModels, CheckpointResumeIsBitIdentical) {
   cfg.planes.push_back({V2{{0, 1}}, -0.02});
   Simulation<2, double> full(cfg, blob(8, 0.02, 5));
   for (int s = 0; s < 25; ++s) full.step();
-  std::stringstream state;
-  full.save_state(state);
+  const auto saved = full.particles();
+  const auto state = full.integrator_state();
   for (int s = 0; s < 25; ++s) full.step();
 
   Simulation<2, double> resumed(cfg, blob(8, 0.02, 5));
-  resumed.load_state(state);
+  resumed.restore(saved, state, "test");
   EXPECT_EQ(resumed.steps(), 25u);
   for (int s = 0; s < 25; ++s) resumed.step();
   EXPECT_TRUE(same_state(full.particles(), resumed.particles()));
@@ -177,15 +177,33 @@ INSTANTIATE_TEST_SUITE_P(Solver, BothModels, ::testing::Values(Model::PaperMulti
                            return std::string(model_name(pi.param));
                          });
 
-TEST(Checkpoint, RejectsMismatchedState) {
+// The file format's own checks (magic, version, dimension, precision, fields, checksum) are tested in
+// io/checkpoint_test.cpp and io/simulation_checkpoint_test.cpp; these are the solver's.
+TEST(Checkpoint, RestoreRejectsParticlesThatDoNotFitAndKeepsItsState) {
   auto cfg = base_config(Model::Wcsph);
   Simulation<2, double> a(cfg, blob(4, 0.02, 1));
   Simulation<2, double> b(cfg, blob(5, 0.02, 1));
-  std::stringstream s;
-  a.save_state(s);
-  EXPECT_THROW(b.load_state(s), InputError);
-  std::stringstream junk("not a checkpoint");
-  EXPECT_THROW(a.load_state(junk), InputError);
+  b.step();
+  const auto before = b.particles();
+  auto expect_input_error = [&](const Particles<2, double>& p, const std::string& what) {
+    try {
+      b.restore(p, a.integrator_state(), "file.ckpt");
+      ADD_FAILURE() << "no InputError for " << what;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("file.ckpt"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    }
+  };
+  expect_input_error(a.particles(), "holds 16 particles, the scene has 25");
+  auto bad = b.particles();
+  bad.phase[3] = 7;
+  expect_input_error(bad, "particle 3 has phase 7");
+  bad = b.particles();
+  bad.kind[4] = 9;
+  expect_input_error(bad, "particle 4 has phase 0 / kind 9");
+  EXPECT_TRUE(same_state(before, b.particles()));
+  EXPECT_EQ(b.steps(), 1u);
 }
 
 TEST(Solver, LeapfrogHalfStepInitialisation) {
@@ -517,11 +535,11 @@ TEST(PerParticleSteps, CheckpointResumeIsBitIdentical) {
   ScopedThreads one(1);
   Simulation<2, double> full(cfg, blob(8, 0.02, 9));
   for (int s = 0; s < 30; ++s) full.step();
-  std::stringstream state;
-  full.save_state(state);
+  const auto saved = full.particles();
+  const auto state = full.integrator_state();
   for (int s = 0; s < 30; ++s) full.step();
   Simulation<2, double> resumed(cfg, blob(8, 0.02, 9));
-  resumed.load_state(state);
+  resumed.restore(saved, state, "test");
   for (int s = 0; s < 30; ++s) resumed.step();
   EXPECT_TRUE(same_state(full.particles(), resumed.particles()));
   EXPECT_EQ(full.time(), resumed.time());

@@ -1,0 +1,30 @@
+#pragma once
+// A Simulation's checkpoint in the io/checkpoint.hpp format (`cellsph run` writes it as checkpoint.bin and
+// reads it for --resume): the particles are its fields, the simulated time and step count its header, and
+// its user blob holds the rest of the integrator state and the caller's own bytes:
+//
+//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data
+//
+// Time and last dt are stored as double: exact for float and double runs, so a resume is bit for bit.
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "cellsph/solver/simulation.hpp"
+
+namespace cellsph {
+
+inline constexpr std::uint32_t kSimulationBlobVersion = 1;
+
+// Writes atomically. `extra`: bytes the caller wants back on resume (the app's frame counter).
+template <int Dim, class Real>
+void write_simulation_checkpoint(const Simulation<Dim, Real>& sim, std::string_view extra,
+                                 const std::filesystem::path& path);
+
+// Reads and validates the file (everything read_checkpoint checks, then the blob), and restores `sim`
+// (Simulation::restore: particle count, phases, kinds). Returns the caller's bytes. Throws InputError
+// naming the file and what is wrong; `sim` is untouched on error.
+template <int Dim, class Real>
+std::string read_simulation_checkpoint(const std::filesystem::path& path, Simulation<Dim, Real>& sim);
+
+}  // namespace cellsph

@@ -1,0 +1,156 @@
+// A Simulation written to a checkpoint file and read back into a fresh Simulation of the same config
+// continues bit for bit (the `--resume` path of `cellsph run`), and files that do not fit are refused with
+// an InputError naming the file.
+#include "cellsph/io/simulation_checkpoint.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <type_traits>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/io/checkpoint.hpp"
+#include "cellsph/io/io_test_util.hpp"
+#include "cellsph/solver/initial.hpp"
+
+namespace cellsph {
+namespace {
+
+// A block of fluid in a box with gravity, velocities jittered so that every step changes every field.
+template <int Dim, class Real>
+Particles<Dim, Real> block(int nx) {
+  using V = Vec<Dim, Real>;
+  Particles<Dim, Real> p;
+  V lo{}, hi{};
+  for (int a = 0; a < Dim; ++a) hi[a] = Real(0.02) * Real(nx);
+  add_block<Dim, Real>(p, lo, hi, Real(0.02), 0);
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (auto& v : p.v)
+    for (int a = 0; a < Dim; ++a) v[a] = Real(u(gen));
+  return p;
+}
+
+template <int Dim, class Real>
+SolverConfig<Dim, Real> config(Model model) {
+  SolverConfig<Dim, Real> c;
+  c.model = model;
+  c.search.method = Method::CellIndex;
+  c.support = Real(0.05);
+  c.phases[0].rest_density = 1000;
+  c.phases[0].mass = Real(1000 * std::pow(0.02, Dim));
+  c.phases[0].viscosity = Real(0.5);
+  c.eos.stiffness = 2000;
+  c.time.mode = TimeStepping::Courant;
+  c.time.dt_max = Real(1e-3);
+  for (int a = 0; a < Dim; ++a) {
+    Vec<Dim, Real> n{};
+    n[a] = 1;
+    c.planes.push_back({n, Real(-0.01)});
+  }
+  return c;
+}
+
+template <int Dim, class Real>
+bool same_fields(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
+  bool same = a.size() == b.size();
+  a.for_each_field([&](std::string_view name, const auto& fa) {
+    b.for_each_field([&](std::string_view nb, const auto& fb) {
+      if constexpr (std::is_same_v<decltype(fa), decltype(fb)>)
+        if (name == nb)
+          same = same && fa.size() == fb.size() &&
+                 std::memcmp(fa.data(), fb.data(), fa.size() * sizeof(fa[0])) == 0;
+    });
+  });
+  return same;
+}
+
+template <int Dim, class Real>
+void resume_is_bit_identical(Model model) {
+  ScopedThreads one(1);
+  test::TempDir dir("sim_ckpt");
+  const auto cfg = config<Dim, Real>(model);
+  Simulation<Dim, Real> full(cfg, block<Dim, Real>(5));
+  for (int s = 0; s < 20; ++s) full.step();
+  const std::string extra("caller\0bytes", 12);  // any bytes, a NUL included
+  write_simulation_checkpoint(full, extra, dir / "c.ckpt");
+  const auto header = read_checkpoint_header(dir / "c.ckpt");
+  EXPECT_EQ(header.dim, Dim);
+  EXPECT_EQ(header.real_size, int(sizeof(Real)));
+  EXPECT_EQ(header.step, 20u);
+  EXPECT_EQ(header.time, double(full.time()));
+  for (int s = 0; s < 20; ++s) full.step();
+
+  Simulation<Dim, Real> resumed(cfg, block<Dim, Real>(5));
+  EXPECT_EQ(read_simulation_checkpoint(dir / "c.ckpt", resumed), extra);
+  EXPECT_EQ(resumed.steps(), 20u);
+  for (int s = 0; s < 20; ++s) resumed.step();
+  EXPECT_TRUE(same_fields(full.particles(), resumed.particles()));
+  EXPECT_EQ(full.time(), resumed.time());
+  EXPECT_EQ(full.last_dt(), resumed.last_dt());
+  EXPECT_EQ(full.steps(), resumed.steps());
+}
+
+// The paper model's leap-frog keeps v(t - dt/2) and the last dt: both must survive the file.
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalPaper2DDouble) {
+  resume_is_bit_identical<2, double>(Model::PaperMultiphase);
+}
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalPaper3DFloat) {
+  resume_is_bit_identical<3, float>(Model::PaperMultiphase);
+}
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalWcsph2DFloat) {
+  resume_is_bit_identical<2, float>(Model::Wcsph);
+}
+
+std::string load_error(const std::filesystem::path& path, Simulation<2, double>& sim) {
+  try {
+    read_simulation_checkpoint(path, sim);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(SimulationCheckpoint, MismatchesAreInputErrorsNamingTheFile) {
+  test::TempDir dir("sim_ckpt_err");
+  const auto cfg = config<2, double>(Model::Wcsph);
+  Simulation<2, double> a(cfg, block<2, double>(4)), b(cfg, block<2, double>(5));
+  a.step();
+  write_simulation_checkpoint(a, "", dir / "a.ckpt");
+  b.step();
+  const auto before = b.particles();
+  const auto file = (dir / "a.ckpt").string();
+
+  auto m = load_error(dir / "a.ckpt", b);
+  EXPECT_NE(m.find("checkpoint '" + file + "': holds 16 particles, the scene has 25"), std::string::npos)
+      << m;
+  EXPECT_TRUE(same_fields(before, b.particles())) << "untouched on error";
+  EXPECT_EQ(b.steps(), 1u);
+
+  // A 3D or single-precision file, and one of the bare format without the integrator state.
+  Simulation<3, double> three(config<3, double>(Model::Wcsph), block<3, double>(2));
+  write_simulation_checkpoint(three, "", dir / "3d.ckpt");
+  m = load_error(dir / "3d.ckpt", b);
+  EXPECT_NE(m.find((dir / "3d.ckpt").string()), std::string::npos) << m;
+  EXPECT_NE(m.find("3D run, cannot continue a 2D run"), std::string::npos) << m;
+  Simulation<2, float> single(config<2, float>(Model::Wcsph), block<2, float>(5));
+  write_simulation_checkpoint(single, "", dir / "f.ckpt");
+  m = load_error(dir / "f.ckpt", b);
+  EXPECT_NE(m.find("precision mismatch: file holds float"), std::string::npos) << m;
+  write_checkpoint(b.particles(), {0.5, 3, ""}, dir / "bare.ckpt");
+  m = load_error(dir / "bare.ckpt", b);
+  EXPECT_NE(m.find((dir / "bare.ckpt").string() + "': integrator state: missing"), std::string::npos) << m;
+  write_checkpoint(b.particles(), {0.5, 3, "CSPHSIM1\x07"}, dir / "short.ckpt");
+  m = load_error(dir / "short.ckpt", b);
+  EXPECT_NE(m.find("integrator state: the user data ends (9 bytes) inside the version"), std::string::npos)
+      << m;
+  EXPECT_TRUE(same_fields(before, b.particles()));
+  EXPECT_EQ(load_error(dir / "a.ckpt", a), "no error");
+}
+
+}  // namespace
+}  // namespace cellsph
