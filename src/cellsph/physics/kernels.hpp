@@ -232,6 +232,27 @@ struct WendlandC2Kernel {
   }
 };
 
+// Akinci et al. 2013 cohesion spline C(r): repulsive (negative) below r = h/2, attractive up to h, zero
+// beyond. 3D: their normalisation 32 / (pi h^9). 2D (not in the paper): the same polynomial scaled so
+// that its integral over the plane equals the 3D one over space (79/336 for every h):
+// 25280 / (627 pi h^8).
+template <int Dim, class Real>
+struct CohesionKernel {
+  static_assert(Dim == 2 || Dim == 3);
+  Real h, norm;
+  explicit CohesionKernel(Real support)
+      : h(support),
+        norm(Dim == 3 ? Real(32.0 / (std::numbers::pi * std::pow(double(support), 9)))
+                      : Real(25280.0 / (627.0 * std::numbers::pi * std::pow(double(support), 8)))) {}
+  CELLSPH_HD Real C(Real r) const {
+    if (!(r > 0) || r > h) return 0;
+    const Real a = (h - r) * (h - r) * (h - r) * r * r * r;
+    if (2 * r > h) return norm * a;
+    const Real h3 = h * h * h;
+    return norm * (2 * a - h3 * h3 / 64);
+  }
+};
+
 // Calls f(kernel) with the kernel of the given kind: the one run-time switch, taken once per loop, so
 // the per-neighbour code is inlined for a concrete kernel type.
 template <int Dim, class Real, class F>

@@ -135,6 +135,29 @@ TEST(Kernels, Poly6LaplacianMatchesCudaWriteupConstant) {
   EXPECT_NEAR(k.laplacian(r), ref, 1e-9 * std::abs(ref));
 }
 
+// Akinci 2013's cohesion spline: the printed 3D form integrates to 79/336 over space (the polynomial
+// integrated by hand: 128 (79 / 43008)); the 2D normalisation gives the same over the plane. Continuous
+// at the knot h/2, zero at h, repulsive near 0, attractive beyond h/2, the printed 3D constant.
+TEST(Kernels, AkinciCohesion) {
+  struct AsW3 {
+    CohesionKernel<3, double> c{kH};
+    double W(double r) const { return c.C(r); }
+  };
+  struct AsW2 {
+    CohesionKernel<2, double> c{kH};
+    double W(double r) const { return c.C(r); }
+  };
+  EXPECT_NEAR(radial_integral<3>(AsW3{}, 200000), 79.0 / 336.0, 1e-8);
+  EXPECT_NEAR(radial_integral<2>(AsW2{}, 200000), 79.0 / 336.0, 1e-8);
+  const CohesionKernel<3, double> c(kH);
+  EXPECT_DOUBLE_EQ(c.norm, 32 / (std::numbers::pi * std::pow(kH, 9)));
+  EXPECT_NEAR(c.C(kH / 2 * (1 - 1e-12)), c.C(kH / 2 * (1 + 1e-12)), 1e-9 * std::abs(c.C(kH / 2)));
+  EXPECT_EQ(c.C(kH), 0.0);
+  EXPECT_EQ(c.C(1.01 * kH), 0.0);
+  EXPECT_LT(c.C(0.1 * kH), 0.0);
+  EXPECT_GT(c.C(0.7 * kH), 0.0);
+}
+
 TEST(Kernels, FloatMatchesDouble) {
   const Poly6Kernel<3, float> kf(0.7f);
   const Poly6Kernel<3, double> kd(kH);

@@ -183,7 +183,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
     }
     if (sr.has("gravity")) cfg.gravity = to_vec<Dim, Real>(sr.vector("gravity", Dim, {}));
     cfg.tension_threshold = static_cast<Real>(sr.number("tension_threshold", 0, 0, 1e12));
-    cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf"}));
+    cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf", "akinci"}));
     cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
     cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
     sr.finish();

@@ -48,6 +48,9 @@ void SolverConfig<Dim, Real>::validate() const {
   positive("time.viscous", time.viscous);
   positive("time.force", time.force);
   if (time.max_level < 0 || time.max_level > 40) bad("time.max_level", time.max_level, "must be in [0, 40]");
+  if (tension != TensionModel::Paper && model != Model::PaperMultiphase)
+    bad("tension", tension_model_name(tension),
+        "the WCSPH model has the write-up's Mueller tension; csf and akinci need the paper model (model = paper)");
   if (time.mode == TimeStepping::PerParticle && model != Model::PaperMultiphase)
     bad("time.mode", "per-particle", "per-particle steps need the paper model's leap-frog (model = paper)");
   if (box.enabled) {
@@ -92,11 +95,12 @@ std::optional<TimeStepping> parse_time_stepping(std::string_view n) {
   return std::nullopt;
 }
 std::string_view tension_model_name(TensionModel t) {
-  return t == TensionModel::Paper ? "paper" : "csf";
+  return t == TensionModel::Paper ? "paper" : t == TensionModel::Csf ? "csf" : "akinci";
 }
 std::optional<TensionModel> parse_tension_model(std::string_view n) {
   if (n == "paper") return TensionModel::Paper;
   if (n == "csf") return TensionModel::Csf;
+  if (n == "akinci") return TensionModel::Akinci;
   return std::nullopt;
 }
 std::string_view correction_name(StepChangeCorrection c) {

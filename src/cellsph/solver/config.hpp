@@ -32,6 +32,13 @@ enum class TensionModel {
   // Continuum surface force with the curvature from the divergence of the unit normal (Brackbill 1992,
   // in SPH as Morris 2000): n = sum_j V_j (c_j - c_i) grad W, kappa = -div(n / |n|), f = sigma kappa n.
   Csf,
+  // Akinci et al. 2013, within each phase: pairwise cohesion -gamma m_i m_j C(r) x_ij / r and curvature
+  // -gamma m (n_i - n_j) with n_i = h sum_j V_j grad W_ij, both scaled by 2 rho0 / (rho_i + rho_j);
+  // sigma of the phase is gamma. Every term is antisymmetric in (i, j): momentum is conserved, so a free
+  // drop does not propel itself as it does under eq. 9 (whose force does not sum to zero). Acts at free
+  // surfaces too (CSF's difference-form normals vanish there); gamma is a model coefficient, not the
+  // physical surface tension.
+  Akinci,
 };
 
 enum class TimeStepping {

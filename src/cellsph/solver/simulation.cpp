@@ -221,6 +221,8 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
   timings_.normal_evals += set.size();
   const Poly6Kernel<Dim, Real> wc(cfg_.support);
+  // Akinci 2013: the full colour gradient h sum_j V_j grad W_ij (non-zero at a free surface).
+  const bool full = cfg_.tension == TensionModel::Akinci;
   normal_.assign(p_.size(), V{});
   for_each_of(set, [&](std::size_t i) {
     V n{};
@@ -228,9 +230,10 @@ void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
     for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
       const std::uint32_t j = *it;
       if (p_.kind[j] != kFluid || distance2(p_.x[i], p_.x[j]) > hi2) continue;
-      n += wc.gradW(p_.x[i] - p_.x[j]) * (p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
+      n += wc.gradW(p_.x[i] - p_.x[j]) *
+           (full ? p_.m[j] / p_.rho[j] : p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
     }
-    normal_[i] = n;
+    normal_[i] = full ? n * p_.h[i] : n;
   });
 }
 
@@ -242,8 +245,11 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
   const ViscosityKernel<Dim, Real> wv(cfg_.support);
   const Real lap_self = wc.laplacian(0);
   const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
+  const bool akinci = any_tension_ && cfg_.tension == TensionModel::Akinci;
+  const bool eq9 = any_tension_ && cfg_.tension == TensionModel::Paper;
   const Real thr2 = cfg_.tension_threshold * cfg_.tension_threshold;
-  if (csf) compute_normals(normal_set);
+  const CohesionKernel<Dim, Real> coh(cfg_.support);
+  if (csf || akinci) compute_normals(normal_set);
   with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wp) {
     for_each_of(set, [&](std::size_t i) {
       const Real vol_i = p_.m[i] / p_.rho[i];
@@ -280,8 +286,16 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
             const V nhat_j = normal_[j] / norm(normal_[j]);
             kappa -= vol_[j] * dot(nhat_j - nhat_i, wc.gradW(in.xij));
             wsum += vol_[j] * wc.W2(in.r * in.r);
-          } else if (any_tension_ && !csf) {
+          } else if (eq9) {
             accumulate_color(cf, in.xij, in.r, vol_[j], p_.color[j], wc);
+          } else if (akinci && p_.phase[j] == p_.phase[i] && in.r > 0) {
+            // Each factor is symmetric in (i, j) and x_ij, n_i - n_j antisymmetric: the pair's forces
+            // on i and j are exact opposites.
+            const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
+            const Real k = (rho0_[i] + rho0_[j]) / (in.rhoi + p_.rho[j]);
+            f += (in.xij * (-ph.sigma * in.mi * p_.m[j] * coh.C(in.r) / in.r) +
+                  (normal_[i] - normal_[j]) * (-ph.sigma * (in.mi + p_.m[j]) / 2)) *
+                 k;
           }
         } else {
           // A boundary particle acts as fluid with i's density (mirrored, so that its volume psi_b / rho_i
@@ -294,13 +308,13 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
           if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
           f += averaged_pressure_force(in, wp);
           if (cfg_.no_slip) f += vel_i * (-vol_i * (in.mj / in.rhoi) * in.mui * wv.laplacian(in.r));
-          if (any_tension_ && !csf) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
+          if (eq9) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
         }
       }
       if (csf_i) {
         const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
         f += normal_[i] * (ph.sigma * kappa / wsum * vol_i);
-      } else if (any_tension_ && !csf) {
+      } else if (eq9) {
         // Eq. 9 has the units of a force density (sigma [N/m] times a curvature of C [1/m^2]); by the
         // paper's own eq. 6 the particle's force is V_i times it. Taken literally as a force it gives
         // accelerations ~1e5 m/s^2 for the paper's sigma, m and h.
@@ -523,7 +537,8 @@ Real Simulation<Dim, Real>::particle_dt(std::size_t i) const {
 // not depend on the order in which threads mark them.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::build_work_sets() {
-  const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
+  // CSF and Akinci read the normals of neighbours, which read the densities of theirs.
+  const bool csf = any_tension_ && (cfg_.tension == TensionModel::Csf || cfg_.tension == TensionModel::Akinci);
   // When every particle is due (often: a uniform limit such as alpha h / c binds them all), the sets are
   // the whole fluid and the marking pass would be pure overhead.
   if (full_passes_ || due_list_.size() == fluid_.size()) {
