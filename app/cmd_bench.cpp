@@ -302,7 +302,8 @@ struct SphArgs {
   int steps = 20;
   int warmup = 3;
   int threads = 2;
-  double skin = -1;  // < 0: the scene's Verlet skin
+  double skin = -1;     // < 0: the scene's Verlet skin
+  int subdivision = 0;  // 0: the scene's H
   bool quick = false;
 };
 
@@ -391,6 +392,8 @@ void run_bench_sph(const SphArgs& a) {
   if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
   if (a.skin != -1 && !(a.skin >= 0 && a.skin <= 1))
     throw InputError("--skin: must be in [0, 1], got " + std::to_string(a.skin));
+  if (a.subdivision < 0 || a.subdivision > 16)
+    throw InputError("--subdivision: must be in [1, 16], got " + std::to_string(a.subdivision));
   int steps = a.steps, warmup = a.warmup;
   if (a.quick) {
     sizes = {2000};
@@ -407,7 +410,8 @@ void run_bench_sph(const SphArgs& a) {
       "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
       "  nbr%% = search / step.\n");
 
-  std::printf("\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double) ==\n");
+  std::printf("\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
+              a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
   std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
               "step ms", "nbr%", "builds", "pairs");
   for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
@@ -417,6 +421,7 @@ void run_bench_sph(const SphArgs& a) {
       nlohmann::json j = base;
       j["neighbors"]["method"] = std::string(method_name(m));
       if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
+      if (a.subdivision > 0) j["neighbors"]["subdivision"] = a.subdivision;
       const StepFigures f = time_scene(j, source, warmup, steps);
       const double step = f.neighbors_ms + f.dynamics_ms;
       std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
@@ -433,8 +438,9 @@ void run_bench_sph(const SphArgs& a) {
   std::printf(
       "\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
       "support 2 s, walls kept), Cell Indexing ==\n");
-  std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s %8s\n", "model", "real", "fluid", "total",
-              "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s", "t end s");
+  std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s %8s %11s\n", "model", "real", "fluid",
+              "total", "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s", "t end s",
+              "pairs/fluid");
   for (std::size_t n : sizes) {
     const double spacing = std::cbrt(volume / static_cast<double>(n));
     for (const auto& model : models) {
@@ -448,10 +454,11 @@ void run_bench_sph(const SphArgs& a) {
         if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
         const StepFigures f = time_scene(j, source, warmup, steps);
         const double step = f.neighbors_ms + f.dynamics_ms;
-        std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f\n",
+        std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f %11.1f\n",
                     model.c_str(), prec.c_str(), f.fluid, f.total, f.neighbors_ms, f.dynamics_ms, f.wall_ms,
                     100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
-                    static_cast<double>(f.fluid) / (f.wall_ms * 1e3), f.t_end);
+                    static_cast<double>(f.fluid) / (f.wall_ms * 1e3), f.t_end,
+                    static_cast<double>(f.pairs) / static_cast<double>(f.fluid));
         std::fflush(stdout);
         ::malloc_trim(0);
       }
@@ -494,6 +501,8 @@ void register_bench(CLI::App& app, int& result) {
   sph->add_option("--steps", sargs->steps, "timed steps per case")->capture_default_str();
   sph->add_option("--warmup", sargs->warmup, "untimed steps first")->capture_default_str();
   sph->add_option("--threads", sargs->threads, "threads")->capture_default_str();
+  sph->add_option("--subdivision", sargs->subdivision,
+                  "H-mask subdivision H of Table 1's searches (cells of size h / H; default: the scenes', 1)");
   sph->add_option("--skin", sargs->skin,
                   "Verlet skin (fraction of h) of every case; 0: a search every step (default: the scenes', 0.15)");
   sph->add_option("--methods", sargs->methods,

@@ -367,11 +367,14 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
         } else {
           Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
-          fp += boundary_pressure_force(in.xij, in.mi, in.rhoi, in.pi, pb, p_.m[j], wg);
+          // boundary_pressure_force, inlined to share the kernel gradient with the no-slip term (same
+          // expression, same bits).
+          const V g = wg.gradW(in.xij);
+          fp += g * (-in.mi * p_.m[j] * (in.pi + pb) / (in.rhoi * in.rhoi));
           if (cfg_.no_slip) {
             // Monaghan's operator against a particle at rest with volume psi_b / rho_i and i's mu.
             const Real q = dot(vel_i, in.xij) / (in.r * in.r + eps2);
-            fnp += wg.gradW(in.xij) * (visc_c * in.mui * vol_i * (p_.m[j] / in.rhoi) * q);
+            fnp += g * (visc_c * in.mui * vol_i * (p_.m[j] / in.rhoi) * q);
           }
           if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, Real(1), wc);
         }
