@@ -410,8 +410,9 @@ void run_bench_sph(const SphArgs& a) {
       "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
       "  nbr%% = search / step.\n");
 
-  std::printf("\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
-              a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
+  std::printf(
+      "\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
+      a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
   std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
               "step ms", "nbr%", "builds", "pairs");
   for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
@@ -501,10 +502,12 @@ void register_bench(CLI::App& app, int& result) {
   sph->add_option("--steps", sargs->steps, "timed steps per case")->capture_default_str();
   sph->add_option("--warmup", sargs->warmup, "untimed steps first")->capture_default_str();
   sph->add_option("--threads", sargs->threads, "threads")->capture_default_str();
-  sph->add_option("--subdivision", sargs->subdivision,
-                  "H-mask subdivision H of Table 1's searches (cells of size h / H; default: the scenes', 1)");
-  sph->add_option("--skin", sargs->skin,
-                  "Verlet skin (fraction of h) of every case; 0: a search every step (default: the scenes', 0.15)");
+  sph->add_option(
+      "--subdivision", sargs->subdivision,
+      "H-mask subdivision H of Table 1's searches (cells of size h / H; default: the scenes', 1)");
+  sph->add_option(
+      "--skin", sargs->skin,
+      "Verlet skin (fraction of h) of every case; 0: a search every step (default: the scenes', 0.15)");
   sph->add_option("--methods", sargs->methods,
                   "comma-separated methods for Table 1 (default: all): " + method_names_joined(","));
   sph->add_option("--models", sargs->models, "models of the 3D runs: wcsph,paper")->capture_default_str();

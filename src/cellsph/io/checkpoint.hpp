@@ -21,7 +21,7 @@ inline constexpr std::uint32_t kCheckpointVersion = 1;
 struct CheckpointInfo {
   double time = 0;         // simulated time [s]
   std::uint64_t step = 0;  // steps taken so far
-  std::string user;        // opaque caller data, stored verbatim (simulation_checkpoint.hpp: the integrator state)
+  std::string user;  // opaque caller data, stored verbatim (simulation_checkpoint.hpp: the integrator state)
 };
 
 // What a checkpoint holds before knowing Dim and Real: lets `--resume` pick the right instantiation.

@@ -50,7 +50,8 @@ void SolverConfig<Dim, Real>::validate() const {
   if (time.max_level < 0 || time.max_level > 40) bad("time.max_level", time.max_level, "must be in [0, 40]");
   if (tension != TensionModel::Paper && model != Model::PaperMultiphase)
     bad("tension", tension_model_name(tension),
-        "the WCSPH model has the write-up's Mueller tension; csf and akinci need the paper model (model = paper)");
+        "the WCSPH model has the write-up's Mueller tension; csf and akinci need the paper model (model = "
+        "paper)");
   if (time.mode == TimeStepping::PerParticle && model != Model::PaperMultiphase)
     bad("time.mode", "per-particle", "per-particle steps need the paper model's leap-frog (model = paper)");
   if (box.enabled) {

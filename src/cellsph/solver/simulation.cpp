@@ -541,7 +541,8 @@ Real Simulation<Dim, Real>::particle_dt(std::size_t i) const {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::build_work_sets() {
   // CSF and Akinci read the normals of neighbours, which read the densities of theirs.
-  const bool csf = any_tension_ && (cfg_.tension == TensionModel::Csf || cfg_.tension == TensionModel::Akinci);
+  const bool csf =
+      any_tension_ && (cfg_.tension == TensionModel::Csf || cfg_.tension == TensionModel::Akinci);
   // When every particle is due (often: a uniform limit such as alpha h / c binds them all), the sets are
   // the whole fluid and the marking pass would be pure overhead.
   if (full_passes_ || due_list_.size() == fluid_.size()) {

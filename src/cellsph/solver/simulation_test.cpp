@@ -427,8 +427,8 @@ TEST(Walls, NoSlipMatchesStokesFirstProblem) {
         const double u = sum[row] / count[row];
         const double ref = no_slip ? u0 * std::erf(y / delta) : u0;
         worst = std::max(worst, std::abs(u - ref) / u0);
-        EXPECT_NEAR(u, ref, (no_slip ? 0.15 : 0.01) * u0) << (no_slip ? "no-slip" : "free-slip") << " y = " << y
-                                      << " model " << static_cast<int>(model);
+        EXPECT_NEAR(u, ref, (no_slip ? 0.15 : 0.01) * u0)
+            << (no_slip ? "no-slip" : "free-slip") << " y = " << y << " model " << static_cast<int>(model);
       }
       std::cout << "[stokes] model " << static_cast<int>(model) << (no_slip ? " no-slip" : " free-slip")
                 << ": worst |u - u_ref| / u0 over the boundary layer " << worst << "\n";
@@ -880,8 +880,9 @@ TEST(InterfaceTension, AkinciFreeDropConservesMomentumAndRounds) {
     std::vector<double> outline(8, 0.0);
     for (std::size_t i = 0; i < q.size(); ++i) {
       const V2 d = q.x[i] - c;
-      const auto sector = static_cast<std::size_t>(
-          std::floor((std::atan2(d[1], d[0]) + std::numbers::pi) / (2 * std::numbers::pi) * 8)) % 8;
+      const auto sector = static_cast<std::size_t>(std::floor((std::atan2(d[1], d[0]) + std::numbers::pi) /
+                                                              (2 * std::numbers::pi) * 8)) %
+                          8;
       outline[sector] = std::max(outline[sector], norm(d) + s / 2);
     }
     const auto [lo, hi] = std::minmax_element(outline.begin(), outline.end());
