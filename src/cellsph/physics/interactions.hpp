@@ -108,10 +108,11 @@ CELLSPH_HD inline Real mirrored_boundary_pressure(Real pi, Real rhoi, const Vec<
   return pi - rhoi * dot(g, xib);  // x_b - x_i = -x_ib
 }
 
-template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Vec<Dim, Real> boundary_pressure_force(const Vec<Dim, Real>& xib, Real mi, Real rhoi,
-                                                         Real pi, Real pb, Real psib, const Kernel& w) {
-  return w.gradW(xib) * (-mi * psib * (pi + pb) / (rhoi * rhoi));
+// grad_w = grad W_ib, taken by the caller so that it can serve the wall's viscous term too.
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> boundary_pressure_force(const Vec<Dim, Real>& grad_w, Real mi, Real rhoi,
+                                                         Real pi, Real pb, Real psib) {
+  return grad_w * (-mi * psib * (pi + pb) / (rhoi * rhoi));
 }
 
 }  // namespace cellsph

@@ -367,10 +367,8 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
         } else {
           Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
-          // boundary_pressure_force, inlined to share the kernel gradient with the no-slip term (same
-          // expression, same bits).
-          const V g = wg.gradW(in.xij);
-          fp += g * (-in.mi * p_.m[j] * (in.pi + pb) / (in.rhoi * in.rhoi));
+          const V g = wg.gradW(in.xij);  // shared by the pressure and the no-slip term
+          fp += boundary_pressure_force(g, in.mi, in.rhoi, in.pi, pb, p_.m[j]);
           if (cfg_.no_slip) {
             // Monaghan's operator against a particle at rest with volume psi_b / rho_i and i's mu.
             const Real q = dot(vel_i, in.xij) / (in.r * in.r + eps2);
