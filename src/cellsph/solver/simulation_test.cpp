@@ -347,65 +347,73 @@ TEST_P(WallModels, HydrostaticTankSettlesToRhoGH) {
 // keeps sloshing (kinetic 55-140 J, excess up to 0.6 m g H) without blowing up, where the write-up's box
 // walls bring it to rest (0.005 J). So the bound here is not the stability test's 10%: Adami's walls cure the
 // blow-up, not the energy gain.
+// The paper model (eq. 8a/8b, same box and EOS) blows up with either wall model: Akinci walls at t = 1.15 s,
+// Adami walls at step 7671 (t = 3.67 s, a particle through the floor); asserted as the open problem it is.
 TEST_P(WallModels, WeaklyViscousBoxHoldsTenThousandSteps) {
-  const double s = 0.025, L = 0.5, H = 0.4, rho0 = 1000, g = 9.81;  // NOLINT
-  const double c = 10 * std::sqrt(2 * g * L);
-  SolverConfig<2, double> cfg = wcsph_water(s, c);
-  cfg.wall_model = GetParam();
-  cfg.phases[0].viscosity = 0.5;
-  cfg.domain_set = true;
-  cfg.domain_lo = V2{{-0.2, -0.2}};
-  cfg.domain_hi = V2{{L + 0.2, L + 0.2}};
-  Particles<2, double> p;
-  add_block<2, double>(p, V2{{0, 0}}, V2{{L, H}}, s, 0);
-  const std::size_t fluid = p.size();
-  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 2, false, 0, rho0 * s * s);
-  ScopedThreads one(1);
-  Simulation<2, double> sim(cfg, std::move(p));
-  // Internal energy of the ratio EOS per unit mass: int_rho0^rho p / r^2 dr = k (ln(rho/rho0) + rho0/rho - 1)
-  // / rho0, for rho > rho0 (clamped: 0 below).
-  const double k = cfg.eos.stiffness;
-  auto energy = [&] {
-    const auto& q = sim.particles();
-    double e = 0;
-    for (std::size_t i = 0; i < fluid; ++i) {
-      e += q.m[i] * (norm2(q.v[i]) / 2 + g * q.x[i][1]);
-      if (q.rho[i] > rho0) e += q.m[i] * k * (std::log(q.rho[i] / rho0) + rho0 / q.rho[i] - 1) / rho0;
+  for (Model model : {Model::Wcsph, Model::PaperMultiphase}) {
+    const double s = 0.025, L = 0.5, H = 0.4, rho0 = 1000, g = 9.81;  // NOLINT
+    const double c = 10 * std::sqrt(2 * g * L);
+    SolverConfig<2, double> cfg = wcsph_water(s, c);
+    cfg.model = model;
+    cfg.wall_model = GetParam();
+    cfg.phases[0].viscosity = 0.5;
+    cfg.domain_set = true;
+    cfg.domain_lo = V2{{-0.2, -0.2}};
+    cfg.domain_hi = V2{{L + 0.2, L + 0.2}};
+    Particles<2, double> p;
+    add_block<2, double>(p, V2{{0, 0}}, V2{{L, H}}, s, 0);
+    const std::size_t fluid = p.size();
+    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 2, false, 0, rho0 * s * s);
+    ScopedThreads one(1);
+    Simulation<2, double> sim(cfg, std::move(p));
+    // Internal energy of the ratio EOS per unit mass: int_rho0^rho p / r^2 dr = k (ln(rho/rho0) + rho0/rho -
+    // 1) / rho0, for rho > rho0 (clamped: 0 below).
+    const double k = cfg.eos.stiffness;
+    auto energy = [&] {
+      const auto& q = sim.particles();
+      double e = 0;
+      for (std::size_t i = 0; i < fluid; ++i) {
+        e += q.m[i] * (norm2(q.v[i]) / 2 + g * q.x[i][1]);
+        if (q.rho[i] > rho0) e += q.m[i] * k * (std::log(q.rho[i] / rho0) + rho0 / q.rho[i] - 1) / rho0;
+      }
+      return e;
+    };
+    const double mass = sim.total_mass(), tol = 0.5 * mass * g * H;
+    sim.step();
+    const double e0 = energy();
+    double e_max = e0;
+    bool blew_up = false;
+    try {
+      for (int n = 1; n < 10000; ++n) {
+        sim.step();
+        if (n % 50 == 0) e_max = std::max(e_max, energy());
+      }
+    } catch (const SimulationError& e) {
+      blew_up = true;
+      std::cout << "[weak viscosity] " << model_name(model) << ", walls " << wall_model_name(GetParam())
+                << ": " << e.what() << "\n";
     }
-    return e;
-  };
-  const double mass = sim.total_mass(), tol = 0.5 * mass * g * H;
-  sim.step();
-  const double e0 = energy();
-  double e_max = e0;
-  bool blew_up = false;
-  try {
-    for (int n = 1; n < 10000; ++n) {
-      sim.step();
-      if (n % 50 == 0) e_max = std::max(e_max, energy());
+    e_max = std::max(e_max, energy());
+    double outside = 0;
+    for (std::size_t i = 0; i < fluid; ++i)
+      for (int a = 0; a < 2; ++a)
+        outside = std::max({outside, -sim.particles().x[i][a], sim.particles().x[i][a] - L});
+    std::cout << "[weak viscosity] " << model_name(model) << ", walls " << wall_model_name(GetParam())
+              << " steps " << sim.steps() << " t " << sim.time() << " E0 " << e0 << " max excess "
+              << (e_max - e0) / (mass * g * H) << " m g H, E_end " << energy() << " KE "
+              << sim.kinetic_energy() << " outside " << outside << "\n";
+    if (GetParam() == WallModel::Akinci || model == Model::PaperMultiphase) {
+      // The open problem, where it remains: fails if it goes away, so that the docs get updated.
+      EXPECT_TRUE(blew_up || e_max - e0 > tol)
+          << model_name(model) << ", walls " << wall_model_name(GetParam())
+          << " no longer blow up: update docs/physics.md";
+      continue;
     }
-  } catch (const SimulationError& e) {
-    blew_up = true;
-    std::cout << "[weak viscosity] walls " << wall_model_name(GetParam()) << ": " << e.what() << "\n";
+    EXPECT_FALSE(blew_up);
+    EXPECT_EQ(sim.steps(), 10000u);
+    EXPECT_LE(e_max - e0, tol);
+    EXPECT_LE(outside, s / 2);
   }
-  e_max = std::max(e_max, energy());
-  double outside = 0;
-  for (std::size_t i = 0; i < fluid; ++i)
-    for (int a = 0; a < 2; ++a)
-      outside = std::max({outside, -sim.particles().x[i][a], sim.particles().x[i][a] - L});
-  std::cout << "[weak viscosity] walls " << wall_model_name(GetParam()) << " steps " << sim.steps() << " t "
-            << sim.time() << " E0 " << e0 << " max excess " << (e_max - e0) / (mass * g * H)
-            << " m g H, E_end " << energy() << " KE " << sim.kinetic_energy() << " outside " << outside
-            << "\n";
-  if (GetParam() == WallModel::Akinci) {
-    // Documents the open problem the Adami walls address; fails if it goes away, so the docs get updated.
-    EXPECT_TRUE(blew_up || e_max - e0 > tol) << "Akinci walls no longer blow up: update docs/physics.md";
-    return;
-  }
-  EXPECT_FALSE(blew_up);
-  EXPECT_EQ(sim.steps(), 10000u);
-  EXPECT_LE(e_max - e0, tol);
-  EXPECT_LE(outside, s / 2);
 }
 
 // Adami walls gather their fluid neighbours from the fluid rows (atomics, then each list sorted): the
