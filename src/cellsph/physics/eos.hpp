@@ -48,6 +48,28 @@ struct EquationOfState {
     return clamp_negative && p < 0 ? Real(0) : p;
   }
 
+  // The inverse of pressure() without clamping: the density at which the state equation gives p (Adami et
+  // al. 2012 give wall particles the density of their extrapolated pressure). Pressures below the
+  // value at rho0 / 2 are taken as that value: further down Tait's and the ratio's inverse run to a
+  // zero density, where p / rho^2 of a wall particle would be unbounded.
+  CELLSPH_HD Real density(Real p, Real rho0) const {
+    EquationOfState<Real> raw = *this;
+    raw.clamp_negative = false;
+    const Real p_min = raw.pressure(rho0 / 2, rho0);
+    if (!(p > p_min)) return rho0 / 2;
+    switch (kind) {
+      case EosKind::Tait:
+        return rho0 * std::pow(1 + p / stiffness, 1 / gamma);
+      case EosKind::Linear:
+        return rho0 + p / stiffness;
+      case EosKind::Ratio:
+        return rho0 * (1 + p / stiffness);
+      case EosKind::Seventh:
+        return rho0 * std::pow(1 + p / stiffness, Real(1) / 7);
+    }
+    return rho0;
+  }
+
   // Speed of sound c = sqrt(dp/drho) at rest density, for the Courant condition (eq. 12).
   Real sound_speed(Real rho0) const {
     switch (kind) {

@@ -13,6 +13,31 @@
 namespace cellsph {
 namespace {
 
+// density() inverts pressure(): hand-computed pairs (rho = 1100 or 1010 for rho0 = 1000), and the floor at
+// rho0 / 2 for pressures below the state equation's value there.
+TEST(Eos, DensityInvertsPressure) {
+  EquationOfState<double> e;
+  e.kind = EosKind::Tait;
+  e.stiffness = 100;
+  e.gamma = 7;
+  EXPECT_NEAR(e.density(100 * (std::pow(1.1, 7) - 1), 1000), 1100, 1e-9);  // 1.1^7 = 1.9487171
+  EXPECT_NEAR(e.density(94.87171, 1000), 1100, 1e-5);
+  e.kind = EosKind::Ratio;
+  e.stiffness = 2e4;
+  EXPECT_NEAR(e.density(200, 1000), 1010, 1e-9);
+  EXPECT_NEAR(e.density(-200, 1000), 990, 1e-9);
+  e.clamp_negative = true;  // the inverse ignores the clamp: p = -200 still means 990
+  EXPECT_NEAR(e.density(-200, 1000), 990, 1e-9);
+  EXPECT_DOUBLE_EQ(e.density(-1e9, 1000), 500);
+  e.kind = EosKind::Linear;
+  e.stiffness = 2;
+  EXPECT_NEAR(e.density(20, 1000), 1010, 1e-9);
+  e.kind = EosKind::Seventh;
+  e.stiffness = 100;
+  EXPECT_NEAR(e.density(94.87171, 1000), 1100, 1e-5);
+  EXPECT_DOUBLE_EQ(e.density(-100, 1000), 500);  // below the floor: (1/2)^7 - 1 = -0.992
+}
+
 TEST(Eos, FormsAndClamp) {
   EquationOfState<double> e;
   e.stiffness = 100;

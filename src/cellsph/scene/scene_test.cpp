@@ -134,6 +134,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"/output/formats", "[\"obj\"]", "/output/formats/0", "obj"},
                       BadCase{"/boundary/box/damping", "0.5", "/boundary/box/damping", "out of range"},
                       BadCase{"/boundary/slip", "\"sticky\"", "/boundary/slip", "sticky"},
+                      BadCase{"/boundary/model", "\"ghost\"", "/boundary/model", "ghost"},
                       BadCase{"/phases", "[]", "/phases", "at least one phase"},
                       BadCase{"/phases/0", R"({"rest_density": -5})", "/phases/0/rest_density", "-5"}));
 

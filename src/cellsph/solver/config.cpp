@@ -54,6 +54,9 @@ void SolverConfig<Dim, Real>::validate() const {
         "paper)");
   if (time.mode == TimeStepping::PerParticle && model != Model::PaperMultiphase)
     bad("time.mode", "per-particle", "per-particle steps need the paper model's leap-frog (model = paper)");
+  // Wall states are computed from all fluid densities of a step; a per-particle sub-step has only some.
+  if (wall_model == WallModel::Adami && time.mode == TimeStepping::PerParticle)
+    bad("boundary.model", "adami", "needs global steps (time.mode fixed or courant), not per-particle");
   if (box.enabled) {
     for (int a = 0; a < Dim; ++a)
       if (!(box.hi[a] - 2 * box.radius > box.lo[a]))
@@ -110,6 +113,14 @@ std::string_view correction_name(StepChangeCorrection c) {
 std::optional<StepChangeCorrection> parse_correction(std::string_view n) {
   if (n == "exact") return StepChangeCorrection::Exact;
   if (n == "printed") return StepChangeCorrection::Printed;
+  return std::nullopt;
+}
+std::string_view wall_model_name(WallModel w) {
+  return w == WallModel::Akinci ? "akinci" : "adami";
+}
+std::optional<WallModel> parse_wall_model(std::string_view n) {
+  if (n == "akinci") return WallModel::Akinci;
+  if (n == "adami") return WallModel::Adami;
   return std::nullopt;
 }
 std::string_view density_formulation_name(DensityFormulation d) {

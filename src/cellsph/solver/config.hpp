@@ -58,6 +58,18 @@ enum class StepChangeCorrection {
   Printed,
 };
 
+// How boundary particles (walls, obstacles) take part in the forces on fluid particles.
+enum class WallModel {
+  // Akinci et al. 2012: per pair, the wall mirrors the fluid particle's density and its pressure
+  // extrapolated hydrostatically from it; no slip: viscosity against a wall at rest.
+  Akinci,
+  // Adami, Hu & Adams 2012: each wall particle gets one pressure per step, the kernel average of its
+  // fluid neighbours' pressures plus the hydrostatic term (their eq. 27), its density from that pressure
+  // through the equation of state, and for no slip the velocity 2 v_wall - (kernel average of the fluid
+  // velocities) (their eq. 22-23); the fluid-wall forces are then ordinary symmetric pair terms.
+  Adami,
+};
+
 // One fluid (or boundary material): the phases table of a scene.
 template <class Real>
 struct Phase {
@@ -126,6 +138,7 @@ struct SolverConfig {
   // Boundary particles (walls, obstacles): free slip (pressure only) or no slip (also the fluid
   // particle's viscosity against a wall at rest, as between two fluid particles).
   bool no_slip = false;
+  WallModel wall_model = WallModel::Akinci;
   Real restitution = Real(0.2);
   Real friction = Real(0.1);
 
@@ -158,6 +171,8 @@ std::string_view tension_model_name(TensionModel t);
 std::optional<TensionModel> parse_tension_model(std::string_view name);
 std::string_view correction_name(StepChangeCorrection c);
 std::optional<StepChangeCorrection> parse_correction(std::string_view name);
+std::string_view wall_model_name(WallModel w);
+std::optional<WallModel> parse_wall_model(std::string_view name);
 std::string_view density_formulation_name(DensityFormulation d);
 std::optional<DensityFormulation> parse_density_formulation(std::string_view name);
 

@@ -97,6 +97,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
     }
   }
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
+  adami_walls_ = cfg_.wall_model == WallModel::Adami && fluid_count_ < n;
   f_pressure_.assign(n, V{});
   init_boundary_weights();
   fluid_.clear();
@@ -215,6 +216,72 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
   });
 }
 
+// Adami, Hu & Adams 2012, for walls at rest (a_w = 0):
+//   p_w = (sum_f p_f W_wf + g . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf       (their eq. 27)
+//   rho_w = the density at which the equation of state gives p_w                 (their eq. 28)
+//   v~_w = 2 v_w - sum_f v_f W_wf / sum_f W_wf = -(the kernel average)            (their eq. 22-23)
+// over the fluid particles f within h_f of w. A step searches boundary particles with support 0 (they
+// have no rows), so the wall's neighbours are gathered from the fluid rows: counted, placed, then each
+// wall's list sorted, so every sum runs in ascending fluid index whatever the thread count or the
+// neighbour method (the set is exactly {f : |x_w - x_f| <= h_f}, the pairs the force pass sees).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_wall_states() {
+  const std::size_t n = p_.size();
+  boundary_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (p_.kind[i] == kBoundary) boundary_.push_back(static_cast<std::uint32_t>(i));
+  if (boundary_.empty()) return;
+  wall_start_.assign(n + 1, 0);
+  auto each_wall_pair = [&](auto&& visit) {
+    for_fluid([&](std::size_t f) {
+      const Real hf2 = p_.h[f] * p_.h[f];
+      for (const auto* it = nl_.begin(f); it != nl_.end(f); ++it) {
+        const std::uint32_t b = *it;
+        if (p_.kind[b] == kBoundary && distance2(p_.x[f], p_.x[b]) <= hf2) visit(f, b);
+      }
+    });
+  };
+  each_wall_pair([&](std::size_t, std::uint32_t b) {
+    std::atomic_ref<std::uint32_t>(wall_start_[b + 1]).fetch_add(1, std::memory_order_relaxed);
+  });
+  for (std::size_t i = 0; i < n; ++i) wall_start_[i + 1] += wall_start_[i];
+  wall_nbr_.resize(wall_start_[n]);
+  std::vector<std::uint32_t>& cursor = wall_cursor_;
+  cursor.assign(wall_start_.begin(), wall_start_.end() - 1);
+  each_wall_pair([&](std::size_t f, std::uint32_t b) {
+    const std::uint32_t k = std::atomic_ref<std::uint32_t>(cursor[b]).fetch_add(1, std::memory_order_relaxed);
+    wall_nbr_[k] = static_cast<std::uint32_t>(f);
+  });
+  wall_v_.resize(n);
+  with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
+    for_each_of(boundary_, [&](std::size_t b) {
+      std::uint32_t* first = wall_nbr_.data() + wall_start_[b];
+      std::uint32_t* last = wall_nbr_.data() + wall_start_[b + 1];
+      std::sort(first, last);
+      Real wsum = 0, psum = 0;
+      V rsum{}, vsum{};
+      for (const std::uint32_t* it = first; it != last; ++it) {
+        const std::uint32_t f = *it;
+        const V xwf = p_.x[b] - p_.x[f];
+        const Real wwf = w.W2(norm2(xwf));
+        wsum += wwf;
+        psum += p_.p[f] * wwf;
+        rsum += xwf * (p_.rho[f] * wwf);
+        vsum += p_.v[f] * wwf;
+      }
+      // A wall particle no fluid particle reaches is read by no force; it keeps rest values.
+      Real pw = wsum > 0 ? (psum + dot(cfg_.gravity, rsum)) / wsum : Real(0);
+      if (cfg_.eos.clamp_negative && pw < 0) pw = 0;
+      const Real rhow = cfg_.eos.density(pw, rho0_[b]);
+      p_.p[b] = pw;
+      p_.rho[b] = rhow;
+      vol_[b] = p_.m[b] / rhow;
+      prho2_[b] = pw / (rhow * rhow);
+      wall_v_[b] = wsum > 0 ? p_.v[b] * Real(2) - vsum / wsum : V{};
+    });
+  });
+}
+
 // CSF normals n_i = sum_j V_j (c_j - c_i) grad W_ij: the difference form vanishes exactly inside a phase.
 // Walls take the colour of the fluid particle, so they contribute nothing.
 template <int Dim, class Real>
@@ -303,11 +370,19 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
           // walls), i's pressure extrapolated to it (see mirrored_boundary_pressure) and i's colour (walls
           // are neutral to interface tension). No slip: eq. 8b against a particle at rest with i's mu.
           in.mj = p_.m[j];
-          in.rhoj = in.rhoi;
-          in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
-          if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
-          f += averaged_pressure_force(in, wp);
-          if (cfg_.no_slip) f += vel_i * (-vol_i * (in.mj / in.rhoi) * in.mui * wv.laplacian(in.r));
+          if (adami_walls_) {
+            // Adami: eq. 8a and 8b as between two fluid particles, with the wall's own pressure and
+            // volume psi_b / rho_w (compute_wall_states) and its extrapolated velocity; i's mu.
+            const Real vv = -vol_i * vol_[j];
+            f += wp.gradW(in.xij) * (vv * (in.pi + p_.p[j]) / 2);
+            if (cfg_.no_slip) f += (vel_i - wall_v_[j]) * (vv * in.mui * wv.laplacian(in.r));
+          } else {
+            in.rhoj = in.rhoi;
+            in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
+            if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
+            f += averaged_pressure_force(in, wp);
+            if (cfg_.no_slip) f += vel_i * (-vol_i * (in.mj / in.rhoi) * in.mui * wv.laplacian(in.r));
+          }
           if (eq9) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
         }
       }
@@ -364,6 +439,16 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
           fnp += g * (visc_c * (in.mui + p_.mu[j]) / 2 * vol_i * vol_[j] * q);
           fp += g * (-in.mi * p_.m[j] * (prho2_i + prho2_[j]));
           if (any_tension_) accumulate_color(cf, in.xij, in.r, vol_[j], Real(1), wc);
+        } else if (adami_walls_) {
+          // Adami: the fluid pair terms with the wall's pressure, density and extrapolated velocity
+          // (compute_wall_states); the viscosity takes i's mu.
+          const V g = wg.gradW(in.xij);
+          fp += g * (-in.mi * p_.m[j] * (prho2_i + prho2_[j]));
+          if (cfg_.no_slip) {
+            const Real q = dot(vel_i - wall_v_[j], in.xij) / (in.r * in.r + eps2);
+            fnp += g * (visc_c * in.mui * vol_i * vol_[j] * q);
+          }
+          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, Real(1), wc);
         } else {
           Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
           if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
@@ -667,6 +752,7 @@ void Simulation<Dim, Real>::step() {
 
   sw.reset();
   compute_density_pressure(fluid_);
+  if (adami_walls_) compute_wall_states();
   if (cfg_.model == Model::PaperMultiphase)
     compute_forces_paper(fluid_, fluid_);
   else

@@ -112,6 +112,9 @@ class Simulation {
   // Per-particle steps: from due_list_, the particles whose normals and densities the forces read.
   void build_work_sets();
   void compute_forces_wcsph();
+  // Adami et al. 2012 walls: pressure, density and no-slip velocity of every boundary particle from its
+  // fluid neighbours, after the density pass.
+  void compute_wall_states();
   Real choose_dt() const;
   void integrate_paper(Real dt);
   void integrate_wcsph(Real dt);
@@ -138,6 +141,13 @@ class Simulation {
   IndexList due_list_, normal_set_, rho_set_;
   std::vector<std::uint8_t> mark_;  // per particle: 1 density needed, 2 normal needed
   bool full_passes_ = false;
+  // Adami walls, rebuilt every step (nothing kept across steps, so the particle arrays may be reordered):
+  // the boundary particles, the fluid neighbours of each (CSR by particle index, ascending within a
+  // row: wall_start_[b] .. wall_start_[b + 1] into wall_nbr_, gathered from the fluid rows) and the
+  // extrapolated wall velocity of the no-slip term.
+  IndexList boundary_;
+  std::vector<std::uint32_t> wall_start_, wall_nbr_, wall_cursor_;
+  std::vector<V> wall_v_;
   std::vector<std::uint32_t> fluid_;  // indices of the fluid particles, ascending (kinds never change)
   // Verlet lists: the step's CSR lists hold the pairs within h + skin of the positions x_built_ and are
   // kept while no particle has moved more than 0.45 skin since (then every pair within h now was
@@ -150,6 +160,7 @@ class Simulation {
   Real skin_ = 0;
   bool lists_valid_ = false;
   bool any_tension_ = false;
+  bool adami_walls_ = false;  // WallModel::Adami and there are boundary particles
   std::size_t fluid_count_ = 0;
 
   // Integrator state (integrator_state(), restore()).

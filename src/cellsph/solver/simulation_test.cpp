@@ -281,10 +281,13 @@ TEST(Walls, BoxClampsAndDamps) {
 // steps of the window [0.5 s, 1 s]: the weakly compressible column keeps ringing acoustically (period
 // 4H/c = 0.05 s) at an amplitude of a few percent, and the mean over many periods is the state it rings
 // about.
-TEST(Hydrostatic, TankSettlesToRhoGH) {
+class WallModels : public ::testing::TestWithParam<WallModel> {};
+
+TEST_P(WallModels, HydrostaticTankSettlesToRhoGH) {
   const double s = 0.02, W = 0.2, H = 0.3, rho0 = 1000, g = 9.81;
   // c: Mach 0.1 for the fastest free-fall speed
   SolverConfig<2, double> cfg = wcsph_water(s, 10 * std::sqrt(2 * g * H));
+  cfg.wall_model = GetParam();
   cfg.search.method = Method::AllPairs;
   cfg.phases[0].viscosity = 20;
   cfg.domain_set = true;
@@ -327,22 +330,169 @@ TEST(Hydrostatic, TankSettlesToRhoGH) {
   EXPECT_NEAR(rho_mean, rho0, 0.01 * rho0);
   EXPECT_NEAR(p_bottom, ref_bottom, 0.05 * ref_bottom);
   EXPECT_LT(sim.kinetic_energy(), 1e-3 * sim.total_mass() * g * H) << "not settled";
-  std::cout << "[hydrostatic] steps " << sim.steps() << " mean rho " << rho_mean << " bottom p " << p_bottom
-            << " ref " << ref_bottom << " KE " << sim.kinetic_energy() << "\n";
+  std::cout << "[hydrostatic] walls " << wall_model_name(GetParam()) << " steps " << sim.steps()
+            << " mean rho " << rho_mean << " bottom p " << p_bottom << " ref " << ref_bottom << " KE "
+            << sim.kinetic_energy() << "\n";
 }
+
+// Issue 3's open problem: weakly viscous water (mu = 0.5 Pa s, no artificial viscosity) in a closed box of
+// two layers of wall particles (0.5 m square, closed, filled to 0.4 m), the two-phase scene's coarse
+// resolution (h = 0.05 m, 2 spacings) with one phase, WCSPH with the hydrostatic tank's clamped ratio EOS (c
+// = 10 sqrt(2 g H)). With Akinci walls it blows up within 0.6-1.8 s (docs/physics.md, "Scene stability"); the
+// same water between the paper's planes settles. Here: 10^4 steps (Courant, 4.8 s): no blow-up
+// (SimulationError), every particle inside the box, and the energy (kinetic + gravitational + the EOS's
+// internal energy) never above its value after the first step by more than half of m g H. Measured: Akinci
+// walls leave the domain at step 2835 (t = 1.36 s, energy 392 J -> 3824 J); Adami walls hold, but still feed
+// energy in: excess 0.23 m g H at 10^4 steps, kinetic energy 71 J, and over 4 x 10^4 steps (19 s) the water
+// keeps sloshing (kinetic 55-140 J, excess up to 0.6 m g H) without blowing up, where the write-up's box
+// walls bring it to rest (0.005 J). So the bound here is not the stability test's 10%: Adami's walls cure the
+// blow-up, not the energy gain.
+// The paper model (eq. 8a/8b, same box and EOS) blows up with either wall model: Akinci walls at t = 1.15 s,
+// Adami walls at step 7671 (t = 3.67 s, a particle through the floor); asserted as the open problem it is.
+TEST_P(WallModels, WeaklyViscousBoxHoldsTenThousandSteps) {
+  for (Model model : {Model::Wcsph, Model::PaperMultiphase}) {
+    const double s = 0.025, L = 0.5, H = 0.4, rho0 = 1000, g = 9.81;  // NOLINT
+    const double c = 10 * std::sqrt(2 * g * L);
+    SolverConfig<2, double> cfg = wcsph_water(s, c);
+    cfg.model = model;
+    cfg.wall_model = GetParam();
+    cfg.phases[0].viscosity = 0.5;
+    cfg.domain_set = true;
+    cfg.domain_lo = V2{{-0.2, -0.2}};
+    cfg.domain_hi = V2{{L + 0.2, L + 0.2}};
+    Particles<2, double> p;
+    add_block<2, double>(p, V2{{0, 0}}, V2{{L, H}}, s, 0);
+    const std::size_t fluid = p.size();
+    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 2, false, 0, rho0 * s * s);
+    ScopedThreads one(1);
+    Simulation<2, double> sim(cfg, std::move(p));
+    // Internal energy of the ratio EOS per unit mass: int_rho0^rho p / r^2 dr = k (ln(rho/rho0) + rho0/rho -
+    // 1) / rho0, for rho > rho0 (clamped: 0 below).
+    const double k = cfg.eos.stiffness;
+    auto energy = [&] {
+      const auto& q = sim.particles();
+      double e = 0;
+      for (std::size_t i = 0; i < fluid; ++i) {
+        e += q.m[i] * (norm2(q.v[i]) / 2 + g * q.x[i][1]);
+        if (q.rho[i] > rho0) e += q.m[i] * k * (std::log(q.rho[i] / rho0) + rho0 / q.rho[i] - 1) / rho0;
+      }
+      return e;
+    };
+    const double mass = sim.total_mass(), tol = 0.5 * mass * g * H;
+    sim.step();
+    const double e0 = energy();
+    double e_max = e0;
+    bool blew_up = false;
+    try {
+      for (int n = 1; n < 10000; ++n) {
+        sim.step();
+        if (n % 50 == 0) e_max = std::max(e_max, energy());
+      }
+    } catch (const SimulationError& e) {
+      blew_up = true;
+      std::cout << "[weak viscosity] " << model_name(model) << ", walls " << wall_model_name(GetParam())
+                << ": " << e.what() << "\n";
+    }
+    e_max = std::max(e_max, energy());
+    double outside = 0;
+    for (std::size_t i = 0; i < fluid; ++i)
+      for (int a = 0; a < 2; ++a)
+        outside = std::max({outside, -sim.particles().x[i][a], sim.particles().x[i][a] - L});
+    std::cout << "[weak viscosity] " << model_name(model) << ", walls " << wall_model_name(GetParam())
+              << " steps " << sim.steps() << " t " << sim.time() << " E0 " << e0 << " max excess "
+              << (e_max - e0) / (mass * g * H) << " m g H, E_end " << energy() << " KE "
+              << sim.kinetic_energy() << " outside " << outside << "\n";
+    if (GetParam() == WallModel::Akinci || model == Model::PaperMultiphase) {
+      // The open problem, where it remains: fails if it goes away, so that the docs get updated.
+      EXPECT_TRUE(blew_up || e_max - e0 > tol)
+          << model_name(model) << ", walls " << wall_model_name(GetParam())
+          << " no longer blow up: update docs/physics.md";
+      continue;
+    }
+    EXPECT_FALSE(blew_up);
+    EXPECT_EQ(sim.steps(), 10000u);
+    EXPECT_LE(e_max - e0, tol);
+    EXPECT_LE(outside, s / 2);
+  }
+}
+
+// Adami walls gather their fluid neighbours from the fluid rows (atomics, then each list sorted): the
+// results must still be bit-identical for 1 and 2 threads and for every neighbour method.
+TEST(Walls, AdamiBitIdenticalAcrossThreadsAndMethods) {
+  const double s = 0.05, rho0 = 1000;
+  SolverConfig<2, double> cfg = wcsph_water(s, 20);
+  cfg.wall_model = WallModel::Adami;
+  cfg.no_slip = true;
+  Particles<2, double> p;
+  add_block<2, double>(p, V2{{0, 0}}, V2{{0.4, 0.6}}, s, 0);
+  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{1.0, 1.0}}, s, 2, true, 0, rho0 * s * s);
+  std::vector<Particles<2, double>> out;
+  for (auto [threads, method] : {std::pair{1, Method::CellIndex}, std::pair{2, Method::CellIndex},
+                                 std::pair{2, Method::AllPairs}, std::pair{2, Method::KdTree}}) {
+    ScopedThreads t(threads);
+    SolverConfig<2, double> c = cfg;
+    c.search.method = method;
+    Simulation<2, double> sim(c, p);
+    for (int n = 0; n < 300; ++n) sim.step();
+    out.push_back(sim.particles());
+  }
+  for (std::size_t k = 1; k < out.size(); ++k) EXPECT_TRUE(same_state(out[0], out[k])) << "run " << k;
+  // The wall state is computed (a bottom wall particle under the column carries pressure).
+  double pmax = 0;
+  for (std::size_t i = 0; i < out[0].size(); ++i)
+    if (out[0].kind[i] == 1) pmax = std::max(pmax, out[0].p[i]);
+  EXPECT_GT(pmax, 0.5 * rho0 * 9.81 * 0.6);
+}
+
+// Adami wall states are recomputed every step from the fluid, so a resumed run (both models) matches an
+// uninterrupted one bit for bit.
+TEST(Walls, AdamiCheckpointResumeIsBitIdentical) {
+  for (Model model : {Model::Wcsph, Model::PaperMultiphase}) {
+    const double s = 0.05, rho0 = 1000;
+    SolverConfig<2, double> cfg = wcsph_water(s, 20);
+    cfg.model = model;
+    cfg.wall_model = WallModel::Adami;
+    cfg.no_slip = true;
+    Particles<2, double> p;
+    add_block<2, double>(p, V2{{0, 0}}, V2{{0.4, 0.6}}, s, 0);
+    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{1.0, 1.0}}, s, 2, true, 0, rho0 * s * s);
+    ScopedThreads one(1);
+    Simulation<2, double> full(cfg, p);
+    for (int n = 0; n < 100; ++n) full.step();
+    const auto saved = full.particles();
+    const auto state = full.integrator_state();
+    for (int n = 0; n < 100; ++n) full.step();
+    Simulation<2, double> resumed(cfg, p);
+    resumed.restore(saved, state, "test");
+    for (int n = 0; n < 100; ++n) resumed.step();
+    EXPECT_TRUE(same_state(full.particles(), resumed.particles())) << model_name(model);
+    EXPECT_EQ(full.time(), resumed.time());
+  }
+}
+
+TEST(Walls, AdamiNeedsGlobalSteps) {
+  SolverConfig<2, double> cfg = base_config(Model::PaperMultiphase);
+  cfg.wall_model = WallModel::Adami;
+  cfg.time.mode = TimeStepping::PerParticle;
+  EXPECT_THROW(cfg.validate(), InputError);
+}
+
+INSTANTIATE_TEST_SUITE_P(Walls, WallModels, ::testing::Values(WallModel::Akinci, WallModel::Adami),
+                         [](const auto& p) { return std::string(wall_model_name(p.param)); });
 
 // 2D dam break of Koshizuka & Oka (1996): a 1 m x 2 m water column in a 4 m tank. The surge front (the
 // largest x of a fluid particle plus half a spacing) must be within 10% of every published point up to
 // T = t sqrt(2g/a) = 3. WCSPH with wall particles; the viscosity is the usual artificial one,
-// mu = rho0 alpha h c / (2(d+2)) with alpha = 0.02. At this coarse spacing (0.1 m, 200 fluid particles) the
-// worst error measured is about 7%; at 0.05 m it is about 12.5% (the simulated front leads the
-// experiment between T = 1 and 2), so this is a check of the set-up at CI resolution, not a convergence
-// claim.
-TEST(DamBreak, KoshizukaOkaSurgeFront) {
+// mu = rho0 alpha h c / (2(d+2)) with alpha = 0.02, no-slip walls of either model (the scene uses Adami's).
+// At this coarse spacing (0.1 m, 200 fluid particles) the worst error measured is 6.3% (Akinci walls) and
+// 8.5% (Adami walls); finer runs lead the experiment between T = 1 and 2 (docs/physics.md), so this is a
+// check of the set-up at CI resolution, not a convergence claim.
+TEST_P(WallModels, DamBreakKoshizukaOkaSurgeFront) {
   const double s = 0.1, rho0 = 1000, g = 9.81, a = 1.0;
   SolverConfig<2, double> cfg = wcsph_water(s, 10 * std::sqrt(2 * g * 2 * a));
   cfg.search.method = Method::AllPairs;
   cfg.no_slip = true;
+  cfg.wall_model = GetParam();
   cfg.domain_set = true;
   cfg.domain_lo = V2{{-0.5, -0.5}};
   cfg.domain_hi = V2{{4 * a + 0.5, 4}};
@@ -376,7 +526,8 @@ TEST(DamBreak, KoshizukaOkaSurgeFront) {
     worst = std::max(worst, std::abs(front - x) / x);
     EXPECT_NEAR(front, x, 0.1 * x) << "t = " << sim.time() << " s";
   }
-  std::cout << "[dam break] worst front error " << 100 * worst << "% over " << ref.size() << " points\n";
+  std::cout << "[dam break] walls " << wall_model_name(GetParam()) << ": worst front error " << 100 * worst
+            << "% over " << ref.size() << " points\n";
 }
 
 // No-slip walls against Stokes' first problem: fluid moving at u0 over a wall at rest (the same as a
@@ -387,51 +538,66 @@ TEST(DamBreak, KoshizukaOkaSurgeFront) {
 // at this spacing (h = 2 spacings), 0.096 / 0.059 at half of it: the simulated layer is thinner (a little
 // slip at the wall: boundary particles at rest, not mirrored velocities) and converges slowly. Free slip:
 // 0.001. Hence 0.15 u0 with no slip (no friction at all would be 0.94 u0 off at the wall) and 0.01 u0
-// without.
+// without. Adami walls (boundary.model adami: the wall takes minus the kernel average of its fluid
+// neighbours' velocities, a mirror of the flow) must do at least as well as Akinci's at rest; measured
+// 0.083 (WCSPH) / 0.040 (paper) against 0.113 / 0.082.
 TEST(Walls, NoSlipMatchesStokesFirstProblem) {
   const double s = 0.02, rho0 = 1000, mu = 10, nu = mu / rho0, u0 = 0.05, t_end = 1.0;
   for (Model model : {Model::Wcsph, Model::PaperMultiphase}) {
-    for (bool no_slip : {true, false}) {
-      SolverConfig<2, double> cfg = wcsph_water(s, 1.0);  // c = 1 m/s = 20 u0
-      cfg.model = model;
-      cfg.gravity = V2{};
-      cfg.phases[0].viscosity = mu;
-      cfg.no_slip = no_slip;
-      Particles<2, double> p;
-      // The block stops short of the end walls: it moves only u0 t = 5 cm, so it never meets them (a
-      // wall would stop the fluid behind a compression wave travelling at c).
-      add_block<2, double>(p, V2{{0.3, 0}}, V2{{2.1, 0.6}}, s, 0);
-      const std::size_t fluid = p.size();
-      p.v.assign(fluid, V2{{u0, 0}});
-      add_box_walls<2, double>(p, V2{{0, 0}}, V2{{2.4, 1.0}}, s, 2, true, 0, rho0 * s * s);
-      p.v.resize(p.size(), V2{});
-      Simulation<2, double> sim(cfg, std::move(p));
-      sim.run_until(t_end);
+    double worst_akinci = 0;
+    for (WallModel walls : {WallModel::Akinci, WallModel::Adami}) {
+      for (bool no_slip : {true, false}) {
+        // Free slip with Adami walls (measured 0.0011 / 0.0008 u0, WCSPH / paper) is left
+        // out of CI (the runs dominate this test, under the sanitizers too).
+        if (!no_slip && walls == WallModel::Adami) continue;
+        SolverConfig<2, double> cfg = wcsph_water(s, 1.0);  // c = 1 m/s = 20 u0
+        cfg.model = model;
+        cfg.wall_model = walls;
+        cfg.gravity = V2{};
+        cfg.phases[0].viscosity = mu;
+        cfg.no_slip = no_slip;
+        Particles<2, double> p;
+        // The block stops short of the end walls: it moves only u0 t = 5 cm, so it never meets them (a
+        // wall would stop the fluid behind a compression wave travelling at c).
+        add_block<2, double>(p, V2{{0.3, 0}}, V2{{2.1, 0.6}}, s, 0);
+        const std::size_t fluid = p.size();
+        p.v.assign(fluid, V2{{u0, 0}});
+        add_box_walls<2, double>(p, V2{{0, 0}}, V2{{2.4, 1.0}}, s, 2, true, 0, rho0 * s * s);
+        p.v.resize(p.size(), V2{});
+        Simulation<2, double> sim(cfg, std::move(p));
+        sim.run_until(t_end);
 
-      // Mean x velocity per lattice row in the middle third (away from the end walls).
-      const double t = sim.time(), delta = 2 * std::sqrt(nu * t);
-      std::vector<double> sum(30, 0.0), count(30, 0.0);
-      for (std::size_t i = 0; i < fluid; ++i) {
-        const auto& x = sim.particles().x[i];
-        if (x[0] < 0.9 || x[0] > 1.5) continue;
-        const auto row = static_cast<std::size_t>(std::floor(x[1] / s));
-        if (row < sum.size()) {
-          sum[row] += sim.particles().v[i][0];
-          count[row] += 1;
+        // Mean x velocity per lattice row in the middle third (away from the end walls).
+        const double t = sim.time(), delta = 2 * std::sqrt(nu * t);
+        std::vector<double> sum(30, 0.0), count(30, 0.0);
+        for (std::size_t i = 0; i < fluid; ++i) {
+          const auto& x = sim.particles().x[i];
+          if (x[0] < 0.9 || x[0] > 1.5) continue;
+          const auto row = static_cast<std::size_t>(std::floor(x[1] / s));
+          if (row < sum.size()) {
+            sum[row] += sim.particles().v[i][0];
+            count[row] += 1;
+          }
+        }
+        double worst = 0;
+        for (std::size_t row = 0; row < 10; ++row) {  // y up to 0.2 m = 2 delta: the boundary layer
+          ASSERT_GT(count[row], 0);
+          const double y = (static_cast<double>(row) + 0.5) * s;
+          const double u = sum[row] / count[row];
+          const double ref = no_slip ? u0 * std::erf(y / delta) : u0;
+          worst = std::max(worst, std::abs(u - ref) / u0);
+          EXPECT_NEAR(u, ref, (no_slip ? 0.15 : 0.01) * u0)
+              << (no_slip ? "no-slip" : "free-slip") << " y = " << y << " model " << static_cast<int>(model)
+              << " walls " << wall_model_name(walls);
+        }
+        std::cout << "[stokes] model " << static_cast<int>(model) << " walls " << wall_model_name(walls)
+                  << (no_slip ? " no-slip" : " free-slip")
+                  << ": worst |u - u_ref| / u0 over the boundary layer " << worst << "\n";
+        if (no_slip && walls == WallModel::Akinci) worst_akinci = worst;
+        if (no_slip && walls == WallModel::Adami) {
+          EXPECT_LE(worst, worst_akinci) << "model " << static_cast<int>(model);
         }
       }
-      double worst = 0;
-      for (std::size_t row = 0; row < 10; ++row) {  // y up to 0.2 m = 2 delta: the boundary layer
-        ASSERT_GT(count[row], 0);
-        const double y = (static_cast<double>(row) + 0.5) * s;
-        const double u = sum[row] / count[row];
-        const double ref = no_slip ? u0 * std::erf(y / delta) : u0;
-        worst = std::max(worst, std::abs(u - ref) / u0);
-        EXPECT_NEAR(u, ref, (no_slip ? 0.15 : 0.01) * u0)
-            << (no_slip ? "no-slip" : "free-slip") << " y = " << y << " model " << static_cast<int>(model);
-      }
-      std::cout << "[stokes] model " << static_cast<int>(model) << (no_slip ? " no-slip" : " free-slip")
-                << ": worst |u - u_ref| / u0 over the boundary layer " << worst << "\n";
     }
   }
 }
