@@ -201,7 +201,8 @@ void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
   V lo = p_.x[slots[0]];
   for (const std::uint32_t i : slots)
     for (int a = 0; a < Dim; ++a) lo[a] = std::min(lo[a], p_.x[i][a]);
-  const Real inv = Real(1) / cfg_.support;
+  static const double cell_experiment = std::getenv("CELLSPH_REORDER_CELL") ? std::atof(std::getenv("CELLSPH_REORDER_CELL")) : 1.0;
+  const Real inv = Real(1) / (cfg_.support * static_cast<Real>(cell_experiment));
   constexpr std::uint64_t cmax = (std::uint64_t{1} << (64 / Dim)) - 1;
   struct Item {
     std::uint64_t key;
@@ -273,6 +274,29 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   ++timings_.list_builds;
 }
 
+// The rows of `set` cut down to the pairs within h_i, in the same (ascending) order: every pair loop
+// then runs without the skin test. That test is a branch taken for about a third of the candidates;
+// once the particles are in cell order (reorder_every) its pattern along a sorted row is irregular, and
+// the mispredictions cost more than this pass (which writes each candidate and advances by the test's
+// outcome, without a branch). The test is the one the loops made before: the same pairs, the same bits.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::filter_lists(const IndexList& set) {
+  within_.resize(nl_.indices.size());
+  within_count_.resize(p_.size());
+  for_each_of(set, [&](std::size_t i) {
+    const V xi = p_.x[i];
+    const Real hi2 = p_.h[i] * p_.h[i];
+    std::uint32_t* out = within_.data() + nl_.offsets[i];
+    std::uint32_t c = 0;
+    for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      const std::uint32_t j = *it;
+      out[c] = j;
+      c += distance2(xi, p_.x[j]) <= hi2 ? 1u : 0u;
+    }
+    within_count_[i] = c;
+  });
+}
+
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
@@ -283,7 +307,6 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
     for_each_of(set, [&](std::size_t i) {
       const V xi = p_.x[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
       Real rho = 0;
       if (number) {
         // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
@@ -291,19 +314,17 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
         // V_b / V_i fluid particles (V_i = m_i / rho0_i), so that with one phase this is eq. 7 exactly.
         Real delta = w.W2(0);
         const Real inv_vol_i = rho0_[i] / p_.m[i];
-        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        for (const auto* it = in_begin(i); it != in_end(i); ++it) {
           const std::uint32_t j = *it;
           const Real r2 = distance2(xi, p_.x[j]);
-          if (r2 > hi2) continue;  // in the Verlet skin only
           const Real wij = w.W2(r2);
           delta += p_.kind[j] == kFluid ? wij : wij * (p_.m[j] / rho0_[j]) * inv_vol_i;
         }
         rho = p_.m[i] * delta;
       } else {
         rho = density_term(w, p_.m[i], Real(0));
-        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        for (const auto* it = in_begin(i); it != in_end(i); ++it) {
           const Real r2 = distance2(xi, p_.x[*it]);
-          if (r2 > hi2) continue;  // in the Verlet skin only
           rho += density_term(w, p_.m[*it], r2);
         }
       }
@@ -327,10 +348,9 @@ void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
   normal_.assign(p_.size(), V{});
   for_each_of(set, [&](std::size_t i) {
     V n{};
-    const Real hi2 = p_.h[i] * p_.h[i];
-    for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+    for (const auto* it = in_begin(i); it != in_end(i); ++it) {
       const std::uint32_t j = *it;
-      if (p_.kind[j] != kFluid || distance2(p_.x[i], p_.x[j]) > hi2) continue;
+      if (p_.kind[j] != kFluid) continue;
       n += wc.gradW(p_.x[i] - p_.x[j]) *
            (full ? p_.m[j] / p_.rho[j] : p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
     }
@@ -364,7 +384,6 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
       const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
       const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
       // CSF: kappa = -div(n / |n|) over neighbours with a defined normal, divided by their kernel sum
@@ -372,10 +391,9 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
       // interface) and underestimated the curvature by 17% (Laplace jump) whatever the resolution.
       Real kappa = 0, wsum = vol_i * wc.W2(0);
       const V vel_i = p_.v[i];
-      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      for (const auto* it = in_begin(i); it != in_end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
-        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
           // averaged_pressure_force and averaged_viscosity_force (eq. 8a, 8b), inlined with the
@@ -449,13 +467,11 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
       const V vel_i = p_.v[i];
       const Real prho2_i = prho2_[i];
-      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      for (const auto* it = in_begin(i); it != in_end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
-        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
           // monaghan_viscosity_force and symmetric_pressure_force, inlined with one kernel gradient
@@ -725,6 +741,7 @@ void Simulation<Dim, Real>::step_per_particle() {
   timings_.neighbors += sw.ms();
   sw.reset();
   build_work_sets();
+  filter_lists(rho_set_);  // every pass below reads rows of rho_set_ only (it holds the other sets)
   compute_density_pressure(rho_set_);
   compute_forces_paper(due_list_, normal_set_);
   std::swap(p_.x, xs_);
@@ -785,6 +802,7 @@ void Simulation<Dim, Real>::step() {
   timings_.neighbors += sw.ms();
 
   sw.reset();
+  filter_lists(fluid_);
   compute_density_pressure(fluid_);
   if (cfg_.model == Model::PaperMultiphase)
     compute_forces_paper(fluid_, fluid_);

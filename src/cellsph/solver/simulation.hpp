@@ -115,7 +115,11 @@ class Simulation {
   // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
   // fluid rows, so boundary particles are then searched with support 0.
   void compute_neighbors(bool boundary_rows = false);
+  [[nodiscard]] const std::uint32_t* in_begin(std::size_t i) const { return within_.data() + nl_.offsets[i]; }
+  [[nodiscard]] const std::uint32_t* in_end(std::size_t i) const { return in_begin(i) + within_count_[i]; }
   using IndexList = std::vector<std::uint32_t>;
+  // The pairs of the rows of `set` within h (the Verlet lists hold h + skin): in_begin(i) .. in_end(i).
+  void filter_lists(const IndexList& set);
   template <class F>
   void for_fluid(F&& f) const;
   template <class F>
@@ -144,6 +148,8 @@ class Simulation {
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
+  std::vector<std::uint32_t> within_;        // filter_lists: row i at nl_.offsets[i], within_count_[i] long
+  std::vector<std::uint32_t> within_count_;
   std::vector<V> normal_;      // CSF: colour gradient n_i of the current step
   std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
   std::vector<Real> rho0_;     // rest density per particle (from its phase)
@@ -162,8 +168,8 @@ class Simulation {
   std::vector<std::uint32_t> fluid_;
   // Verlet lists: the step's CSR lists hold the pairs within h + skin of the positions x_built_ and are
   // kept while no particle has moved more than 0.45 skin since (then every pair within h now was
-  // within h + skin then: triangle inequality). Every pair loop skips pairs with
-  // distance2(x_i, x_j) > h_i^2, the search's own test, so each sum runs over exactly the neighbours
+  // within h + skin then: triangle inequality). Each step filter_lists() cuts the rows to the pairs
+  // with distance2(x_i, x_j) <= h_i^2, the search's own test, so each sum runs over exactly the neighbours
   // an exact search gives, in the same (ascending) order: results do not depend on the skin, the
   // rebuild schedule, the method or a resume.
   std::vector<Real> search_h_;  // support per particle for the lists: h + skin (0 for boundary)
