@@ -82,8 +82,17 @@ bool is_permutation_of_iota(std::vector<std::uint32_t> id) {
 TEST(Reorder, SamePhysicsPerIdAsNoReorder) {
   ScopedThreads one(1);  // thread independence is tested below
   const double s = 0.1;
+  // Two phases of different rest density (the right half of the column 10% denser), so that a
+  // per-particle array of the solver (rest density) left unpermuted would show.
   auto run = [&](std::uint32_t every) {
-    Simulation<2, double> sim(dam_config(s, every), dam_particles(s));
+    auto cfg = dam_config(s, every);
+    cfg.phases.push_back(cfg.phases[0]);
+    cfg.phases[1].rest_density = 1100;
+    cfg.phases[1].mass = 1100 * s * s;
+    auto p = dam_particles(s);
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == 0 && p.x[i][0] > 0.5) p.phase[i] = 1;
+    Simulation<2, double> sim(cfg, std::move(p));
     for (int k = 0; k < 400; ++k) sim.step();
     return sim;
   };
