@@ -323,8 +323,8 @@ struct StepFigures {
 // timed step by step in turn (A B A B ...), so that the load of a shared machine weighs on all alike
 // and their ratio is meaningful even when the absolute figures drift.
 template <int Dim, class Real>
-std::vector<StepFigures> time_steps(const std::vector<nlohmann::json>& js, const std::string& source, int warmup,
-                                    int steps) {
+std::vector<StepFigures> time_steps(const std::vector<nlohmann::json>& js, const std::string& source,
+                                    int warmup, int steps) {
   std::vector<std::unique_ptr<Simulation<Dim, Real>>> sims;
   for (const auto& j : js) {
     Scene<Dim, Real> scene = load_scene<Dim, Real>(j, source);
@@ -359,8 +359,8 @@ std::vector<StepFigures> time_steps(const std::vector<nlohmann::json>& js, const
   return out;
 }
 
-std::vector<StepFigures> time_scene(const std::vector<nlohmann::json>& js, const std::string& source, int warmup,
-                                    int steps) {
+std::vector<StepFigures> time_scene(const std::vector<nlohmann::json>& js, const std::string& source,
+                                    int warmup, int steps) {
   const SceneHeader h = read_scene_header(js.front(), source);
   if (h.dim == 2)
     return h.single_precision ? time_steps<2, float>(js, source, warmup, steps)
@@ -468,9 +468,9 @@ void run_bench_sph(const SphArgs& a) {
   std::printf(
       "\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
       "support 2 s, walls kept), Cell Indexing ==\n");
-  std::printf("  %-8s %-7s %8s %10s %10s %11s %12s %10s %6s %7s %14s %8s %11s\n", "model", "real", "reorder", "fluid",
-              "total", "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s", "t end s",
-              "pairs/fluid");
+  std::printf("  %-8s %-7s %8s %10s %10s %11s %12s %10s %6s %7s %14s %8s %11s\n", "model", "real", "reorder",
+              "fluid", "total", "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s",
+              "t end s", "pairs/fluid");
   for (std::size_t n : sizes) {
     const double spacing = std::cbrt(volume / static_cast<double>(n));
     for (const auto& model : models) {
@@ -492,11 +492,11 @@ void run_bench_sph(const SphArgs& a) {
         for (std::size_t k = 0; k < figures.size(); ++k) {
           const StepFigures& f = figures[k];
           const double step = f.neighbors_ms + f.dynamics_ms;
-          const std::string reorder =
-              reorders.empty() ? "scene" : std::to_string(reorders[k]);
+          const std::string reorder = reorders.empty() ? "scene" : std::to_string(reorders[k]);
           std::printf("  %-8s %-7s %8s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f %11.1f\n",
-                      model.c_str(), prec.c_str(), reorder.c_str(), f.fluid, f.total, f.neighbors_ms, f.dynamics_ms,
-                      f.wall_ms, 100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
+                      model.c_str(), prec.c_str(), reorder.c_str(), f.fluid, f.total, f.neighbors_ms,
+                      f.dynamics_ms, f.wall_ms, 100 * f.neighbors_ms / step,
+                      static_cast<unsigned long long>(f.builds),
                       static_cast<double>(f.fluid) / (f.wall_ms * 1e3), f.t_end,
                       static_cast<double>(f.pairs) / static_cast<double>(f.fluid));
         }
@@ -548,10 +548,11 @@ void register_bench(CLI::App& app, int& result) {
   sph->add_option(
       "--skin", sargs->skin,
       "Verlet skin (fraction of h) of every case; 0: a search every step (default: the scenes', 0.15)");
-  sph->add_option("--reorder", sargs->reorder,
-                  "reorder the particles into cell order every N steps (neighbors.reorder_every; 0: never); a "
-                  "comma-separated list runs the 3D cases once per value, timed in turn step by step "
-                  "(default: the scenes')");
+  sph->add_option(
+      "--reorder", sargs->reorder,
+      "reorder the particles into cell order every N steps (neighbors.reorder_every; 0: never); a "
+      "comma-separated list runs the 3D cases once per value, timed in turn step by step "
+      "(default: the scenes')");
   sph->add_option("--methods", sargs->methods,
                   "comma-separated methods for Table 1 (default: all): " + method_names_joined(","));
   sph->add_option("--models", sargs->models, "models of the 3D runs: wcsph,paper")->capture_default_str();

@@ -77,10 +77,10 @@ TEST(ExtendedFields, VtuHasTheNewArraysWithTheirTypes) {
 TEST(ExtendedFields, CsvAppendsTheNewColumns) {
   test::TempDir dir("ext_csv");
   const auto e = make_extended(3);
-  EXPECT_EQ(
-      (csv_header_any<ExtendedParticles<2, float>>()),
-      "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind,id,flag,serial,"
-      "normal_x,normal_y");
+  EXPECT_EQ((csv_header_any<ExtendedParticles<2, float>>()),
+            "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind,"
+            "id,flag,serial,"
+            "normal_x,normal_y");
   write_csv_any(e, dir / "e.csv", {});
   const std::string text = test::slurp(dir / "e.csv");
   const auto row2 = text.find('\n', text.find('\n', text.find('\n') + 1) + 1) + 1;  // third data row

@@ -42,8 +42,8 @@ class FrameOutput {
   CsvRowFilter fluid_;
   FramesIndex index_;
   PvdWriter pvd_;
-  Particles<Dim, Real> ordered_;        // the particles in id order, when they are not already
-  std::vector<std::uint32_t> from_;     // index in the caller's particles of each of ordered_
+  Particles<Dim, Real> ordered_;     // the particles in id order, when they are not already
+  std::vector<std::uint32_t> from_;  // index in the caller's particles of each of ordered_
 };
 
 }  // namespace cellsph

@@ -57,14 +57,16 @@ TEST(FrameOutput, WritesParticlesInIdOrder) {
   });
   ASSERT_FALSE(in_id_order(q));
   // Drop the internal indices 1 and 4 (ids 7 and 2).
-  FrameOutput<2, double> out(dir.path(), parse_output_formats("csv"), [](std::size_t i) { return i != 1 && i != 4; });
+  FrameOutput<2, double> out(dir.path(), parse_output_formats("csv"),
+                             [](std::size_t i) { return i != 1 && i != 4; });
   out.write(q, 0, 0.0);
   std::istringstream in(test::slurp(dir.path() / "frame_00000.csv"));
   std::string line;
   std::getline(in, line);
   std::vector<std::string> header;
   for (std::stringstream hs(line); std::getline(hs, line, ',');) header.push_back(line);
-  const auto id_col = static_cast<std::size_t>(std::find(header.begin(), header.end(), "id") - header.begin());
+  const auto id_col =
+      static_cast<std::size_t>(std::find(header.begin(), header.end(), "id") - header.begin());
   ASSERT_LT(id_col, header.size());
   std::vector<std::uint32_t> ids;
   while (std::getline(in, line)) {

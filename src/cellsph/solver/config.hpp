@@ -140,10 +140,12 @@ struct SolverConfig {
   Real verlet_skin = Real(0.15);
   // Every this many steps the fluid particles' arrays are permuted into cell order (Z-order of cells of
   // size h, ties by id), so that neighbours sit near each other in memory; 0: never (input order kept).
+  // Off by default: on the 3D dam break at 10^5 it cost 7-12% while the fluid still holds its input
+  // lattice order and gained 1-4% after the impact (docs/benchmarks.md).
   // With per-particle steps: whenever the clock reaches a multiple of reorder_every * dt_max, where
   // every particle is due. Results depend on it only through summation order (last bits), never on
   // the method, skin or thread count; the id field keeps each particle's identity.
-  std::uint32_t reorder_every = 50;
+  std::uint32_t reorder_every = 0;
   std::uint64_t seed = 1;
 
   static constexpr V gravity_default() {

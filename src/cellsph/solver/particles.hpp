@@ -84,20 +84,23 @@ bool in_id_order(const Particles<Dim, Real>& p) {
 // dst = src with every field gathered into id order (dst particle k is the src particle with id k);
 // `from` receives the src index of each dst particle. The ids must be a permutation of 0..n-1.
 template <int Dim, class Real>
-void copy_in_id_order(const Particles<Dim, Real>& src, Particles<Dim, Real>& dst, std::vector<std::uint32_t>& from) {
+void copy_in_id_order(const Particles<Dim, Real>& src, Particles<Dim, Real>& dst,
+                      std::vector<std::uint32_t>& from) {
   const std::size_t n = src.size();
   CELLSPH_CHECK(src.id.size() == n, "particle ids: " << src.id.size() << " for " << n << " particles");
   constexpr std::uint32_t kNone = ~std::uint32_t{0};
   from.assign(n, kNone);
   for (std::size_t s = 0; s < n; ++s) {
     const std::uint32_t k = src.id[s];
-    CELLSPH_CHECK(k < n && from[k] == kNone, "particle ids are not a permutation: particle " << s << " has id " << k);
+    CELLSPH_CHECK(k < n && from[k] == kNone,
+                  "particle ids are not a permutation: particle " << s << " has id " << k);
     from[k] = static_cast<std::uint32_t>(s);
   }
   dst.resize(n);
   Particles<Dim, Real>::for_each_field(src, [&](std::string_view name, const auto& field) {
     Particles<Dim, Real>::for_each_field(dst, [&](std::string_view dname, auto& out) {
-      if constexpr (std::is_same_v<std::remove_cvref_t<decltype(field)>, std::remove_cvref_t<decltype(out)>>) {
+      if constexpr (std::is_same_v<std::remove_cvref_t<decltype(field)>,
+                                   std::remove_cvref_t<decltype(out)>>) {
         if (dname != name) return;
         for (std::size_t k = 0; k < n; ++k) out[k] = field[from[k]];
       }

@@ -258,7 +258,8 @@ TEST(Reorder, ThreeDimensionsFloat) {
     return by_id(sim.particles());
   };
   ScopedThreads one(1);
-  const auto cell = make(Method::CellIndex, 4), tree = make(Method::KdTree, 4), off = make(Method::CellIndex, 0);
+  const auto cell = make(Method::CellIndex, 4), tree = make(Method::KdTree, 4),
+             off = make(Method::CellIndex, 0);
   EXPECT_TRUE(same_state(cell, tree));
   float worst = 0, moved = 0;
   for (std::size_t k = 0; k < off.size(); ++k) {

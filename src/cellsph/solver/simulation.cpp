@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <istream>
 #include <limits>
@@ -201,15 +200,13 @@ void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
   V lo = p_.x[slots[0]];
   for (const std::uint32_t i : slots)
     for (int a = 0; a < Dim; ++a) lo[a] = std::min(lo[a], p_.x[i][a]);
-  static const double cell_experiment = std::getenv("CELLSPH_REORDER_CELL") ? std::atof(std::getenv("CELLSPH_REORDER_CELL")) : 1.0;
-  const Real inv = Real(1) / (cfg_.support * static_cast<Real>(cell_experiment));
+  const Real inv = Real(1) / cfg_.support;
   constexpr std::uint64_t cmax = (std::uint64_t{1} << (64 / Dim)) - 1;
   struct Item {
     std::uint64_t key;
     std::uint32_t id, slot;
   };
   std::vector<Item> items(m);
-  static const bool linear_experiment = std::getenv("CELLSPH_REORDER_LINEAR") != nullptr;
   parallel_for(m, [&](std::size_t k) {
     const std::uint32_t i = slots[k];
     std::uint64_t c[Dim];
@@ -218,12 +215,7 @@ void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
       const Real q = std::min(std::floor((p_.x[i][a] - lo[a]) * inv), static_cast<Real>(cmax));
       c[a] = std::min(static_cast<std::uint64_t>(q), cmax);
     }
-    std::uint64_t key = morton_key<Dim>(c);
-    if (linear_experiment) {  // TEMPORARY: measurement of the linear cell key
-      key = 0;
-      for (int a = Dim - 1; a >= 0; --a) key = key * 4096 + c[a];
-    }
-    items[k] = {key, p_.id[i], i};
+    items[k] = {morton_key<Dim>(c), p_.id[i], i};
   });
   std::sort(items.begin(), items.end(),
             [](const Item& a, const Item& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
@@ -865,7 +857,8 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
     throw InputError(source + ": holds " + std::to_string(particles.id.size()) + " particle ids for " +
                      std::to_string(n) + " particles");
   }
-  if (const auto err = id_permutation_error(particles.id); !err.empty()) throw InputError(source + ": " + err);
+  if (const auto err = id_permutation_error(particles.id); !err.empty())
+    throw InputError(source + ": " + err);
   for (std::size_t i = 0; i < n; ++i) {
     if (particles.phase[i] < 0 || static_cast<std::size_t>(particles.phase[i]) >= cfg_.phases.size() ||
         particles.kind[i] > kBoundary) {

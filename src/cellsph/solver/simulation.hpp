@@ -64,8 +64,8 @@ class Simulation {
 
   // Validates the config (InputError) and completes the particles: x, v, m, phase, kind and id are the
   // inputs (id may be left empty or all 0: the input order; otherwise it must be a permutation of
-  // 0..n-1; v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid particle:
-  // the phase's mass). support, colour and viscosity are set from the config and the phase table,
+  // 0..n-1; v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid
+  // particle: the phase's mass). support, colour and viscosity are set from the config and the phase table,
   // density to the rest density; boundary particles with m == 0 get their Akinci weight psi_b in m (a
   // positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick,
   // m = rho0 spacing^Dim makes the wall look exactly like fluid).
@@ -148,7 +148,7 @@ class Simulation {
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
-  std::vector<std::uint32_t> within_;        // filter_lists: row i at nl_.offsets[i], within_count_[i] long
+  std::vector<std::uint32_t> within_;  // filter_lists: row i at nl_.offsets[i], within_count_[i] long
   std::vector<std::uint32_t> within_count_;
   std::vector<V> normal_;      // CSF: colour gradient n_i of the current step
   std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
