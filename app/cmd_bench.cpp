@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -303,6 +304,7 @@ struct SphArgs {
   int warmup = 3;
   int threads = 2;
   double skin = -1;     // < 0: the scene's Verlet skin
+  std::string reorder;  // reorder_every values, comma-separated; empty: the scene's
   int subdivision = 0;  // 0: the scene's H
   bool quick = false;
 };
@@ -317,36 +319,54 @@ struct StepFigures {
   double t_end = 0;                          // simulated time after the timed steps [s]
 };
 
+// Several variants of one case (the same scene with other settings), each warmed up on its own, then
+// timed step by step in turn (A B A B ...), so that the load of a shared machine weighs on all alike
+// and their ratio is meaningful even when the absolute figures drift.
 template <int Dim, class Real>
-StepFigures time_steps(const nlohmann::json& j, const std::string& source, int warmup, int steps) {
-  Scene<Dim, Real> scene = load_scene<Dim, Real>(j, source);
-  Simulation<Dim, Real> sim(scene.solver, std::move(scene.particles));
-  for (int s = 0; s < warmup; ++s) sim.step();
-  const StepTimings t0 = sim.timings();
-  Stopwatch sw;
-  for (int s = 0; s < steps; ++s) sim.step();
-  const double wall = sw.ms();
-  const StepTimings& t1 = sim.timings();
-  StepFigures f;
-  f.fluid = sim.fluid_count();
-  f.total = sim.particles().size();
-  f.steps = steps;
-  f.neighbors_ms = (t1.neighbors - t0.neighbors) / steps;
-  f.dynamics_ms = (t1.forces - t0.forces + t1.integration - t0.integration) / steps;
-  f.wall_ms = wall / steps;
-  f.pairs = sim.search_stats().pairs;
-  f.builds = t1.list_builds - t0.list_builds;
-  f.t_end = static_cast<double>(sim.time());
-  return f;
+std::vector<StepFigures> time_steps(const std::vector<nlohmann::json>& js, const std::string& source,
+                                    int warmup, int steps) {
+  std::vector<std::unique_ptr<Simulation<Dim, Real>>> sims;
+  for (const auto& j : js) {
+    Scene<Dim, Real> scene = load_scene<Dim, Real>(j, source);
+    sims.push_back(std::make_unique<Simulation<Dim, Real>>(scene.solver, std::move(scene.particles)));
+    for (int s = 0; s < warmup; ++s) sims.back()->step();
+  }
+  std::vector<StepTimings> t0;
+  for (const auto& sim : sims) t0.push_back(sim->timings());
+  std::vector<double> wall(sims.size(), 0);
+  for (int s = 0; s < steps; ++s)
+    for (std::size_t k = 0; k < sims.size(); ++k) {
+      Stopwatch sw;
+      sims[k]->step();
+      wall[k] += sw.ms();
+    }
+  std::vector<StepFigures> out;
+  for (std::size_t k = 0; k < sims.size(); ++k) {
+    const auto& sim = *sims[k];
+    const StepTimings& t1 = sim.timings();
+    StepFigures f;
+    f.fluid = sim.fluid_count();
+    f.total = sim.particles().size();
+    f.steps = steps;
+    f.neighbors_ms = (t1.neighbors - t0[k].neighbors) / steps;
+    f.dynamics_ms = (t1.forces - t0[k].forces + t1.integration - t0[k].integration) / steps;
+    f.wall_ms = wall[k] / steps;
+    f.pairs = sim.search_stats().pairs;
+    f.builds = t1.list_builds - t0[k].list_builds;
+    f.t_end = static_cast<double>(sim.time());
+    out.push_back(f);
+  }
+  return out;
 }
 
-StepFigures time_scene(const nlohmann::json& j, const std::string& source, int warmup, int steps) {
-  const SceneHeader h = read_scene_header(j, source);
+std::vector<StepFigures> time_scene(const std::vector<nlohmann::json>& js, const std::string& source,
+                                    int warmup, int steps) {
+  const SceneHeader h = read_scene_header(js.front(), source);
   if (h.dim == 2)
-    return h.single_precision ? time_steps<2, float>(j, source, warmup, steps)
-                              : time_steps<2, double>(j, source, warmup, steps);
-  return h.single_precision ? time_steps<3, float>(j, source, warmup, steps)
-                            : time_steps<3, double>(j, source, warmup, steps);
+    return h.single_precision ? time_steps<2, float>(js, source, warmup, steps)
+                              : time_steps<2, double>(js, source, warmup, steps);
+  return h.single_precision ? time_steps<3, float>(js, source, warmup, steps)
+                            : time_steps<3, double>(js, source, warmup, steps);
 }
 
 std::vector<Method> parse_methods(const std::string& text) {
@@ -392,6 +412,14 @@ void run_bench_sph(const SphArgs& a) {
   if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
   if (a.skin != -1 && !(a.skin >= 0 && a.skin <= 1))
     throw InputError("--skin: must be in [0, 1], got " + std::to_string(a.skin));
+  std::vector<long> reorders;  // empty: the scenes' value
+  for (const auto& r : a.reorder.empty() ? std::vector<std::string>{} : split(a.reorder)) {
+    char* end = nullptr;
+    const long v = std::strtol(r.c_str(), &end, 10);
+    if (r.empty() || *end != 0 || v < 0 || v > 1000000)
+      throw InputError("--reorder: '" + r + "' is not a step count in [0, 1000000]");
+    reorders.push_back(v);
+  }
   if (a.subdivision < 0 || a.subdivision > 16)
     throw InputError("--subdivision: must be in [1, 16], got " + std::to_string(a.subdivision));
   int steps = a.steps, warmup = a.warmup;
@@ -408,7 +436,7 @@ void run_bench_sph(const SphArgs& a) {
       "  search = NeighborSearch build + find_all (Verlet lists: only when a particle has moved\n"
       "  0.45 skin; builds = searches run in the timed steps) + the displacement check; dynamics =\n"
       "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
-      "  nbr%% = search / step.\n");
+      "  nbr%% = search / step; step ms of the 3D table (wall) also holds the reorders into cell order.\n");
 
   std::printf(
       "\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
@@ -422,8 +450,9 @@ void run_bench_sph(const SphArgs& a) {
       nlohmann::json j = base;
       j["neighbors"]["method"] = std::string(method_name(m));
       if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
+      if (!reorders.empty()) j["neighbors"]["reorder_every"] = reorders.front();
       if (a.subdivision > 0) j["neighbors"]["subdivision"] = a.subdivision;
-      const StepFigures f = time_scene(j, source, warmup, steps);
+      const StepFigures f = time_scene({j}, source, warmup, steps).front();
       const double step = f.neighbors_ms + f.dynamics_ms;
       std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
                   std::string(method_name(m)).c_str(), f.neighbors_ms, f.dynamics_ms, step,
@@ -439,9 +468,9 @@ void run_bench_sph(const SphArgs& a) {
   std::printf(
       "\n== 3D dam break (dam-break-3d rescaled: spacing s for the requested fluid count, "
       "support 2 s, walls kept), Cell Indexing ==\n");
-  std::printf("  %-8s %-7s %10s %10s %11s %12s %10s %6s %7s %14s %8s %11s\n", "model", "real", "fluid",
-              "total", "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s", "t end s",
-              "pairs/fluid");
+  std::printf("  %-8s %-7s %8s %10s %10s %11s %12s %10s %6s %7s %14s %8s %11s\n", "model", "real", "reorder",
+              "fluid", "total", "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s",
+              "t end s", "pairs/fluid");
   for (std::size_t n : sizes) {
     const double spacing = std::cbrt(volume / static_cast<double>(n));
     for (const auto& model : models) {
@@ -453,13 +482,24 @@ void run_bench_sph(const SphArgs& a) {
         j["precision"] = prec;
         j["neighbors"]["method"] = "cell-index";
         if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
-        const StepFigures f = time_scene(j, source, warmup, steps);
-        const double step = f.neighbors_ms + f.dynamics_ms;
-        std::printf("  %-8s %-7s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f %11.1f\n",
-                    model.c_str(), prec.c_str(), f.fluid, f.total, f.neighbors_ms, f.dynamics_ms, f.wall_ms,
-                    100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
-                    static_cast<double>(f.fluid) / (f.wall_ms * 1e3), f.t_end,
-                    static_cast<double>(f.pairs) / static_cast<double>(f.fluid));
+        std::vector<nlohmann::json> variants;
+        for (const long r : reorders) {
+          variants.push_back(j);
+          variants.back()["neighbors"]["reorder_every"] = r;
+        }
+        if (variants.empty()) variants.push_back(j);
+        const auto figures = time_scene(variants, source, warmup, steps);
+        for (std::size_t k = 0; k < figures.size(); ++k) {
+          const StepFigures& f = figures[k];
+          const double step = f.neighbors_ms + f.dynamics_ms;
+          const std::string reorder = reorders.empty() ? "scene" : std::to_string(reorders[k]);
+          std::printf("  %-8s %-7s %8s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f %11.1f\n",
+                      model.c_str(), prec.c_str(), reorder.c_str(), f.fluid, f.total, f.neighbors_ms,
+                      f.dynamics_ms, f.wall_ms, 100 * f.neighbors_ms / step,
+                      static_cast<unsigned long long>(f.builds),
+                      static_cast<double>(f.fluid) / (f.wall_ms * 1e3), f.t_end,
+                      static_cast<double>(f.pairs) / static_cast<double>(f.fluid));
+        }
         std::fflush(stdout);
         ::malloc_trim(0);
       }
@@ -508,6 +548,11 @@ void register_bench(CLI::App& app, int& result) {
   sph->add_option(
       "--skin", sargs->skin,
       "Verlet skin (fraction of h) of every case; 0: a search every step (default: the scenes', 0.15)");
+  sph->add_option(
+      "--reorder", sargs->reorder,
+      "reorder the particles into cell order every N steps (neighbors.reorder_every; 0: never); a "
+      "comma-separated list runs the 3D cases once per value, timed in turn step by step "
+      "(default: the scenes')");
   sph->add_option("--methods", sargs->methods,
                   "comma-separated methods for Table 1 (default: all): " + method_names_joined(","));
   sph->add_option("--models", sargs->models, "models of the 3D runs: wcsph,paper")->capture_default_str();

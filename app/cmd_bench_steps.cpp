@@ -71,7 +71,10 @@ RunFigures run_one(const nlohmann::json& j, const std::string& source, const Ste
     s.t = static_cast<double>(sim.time());
     s.front = -1e300;
     std::vector<double> xs;
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    // In id order: the runs reorder their arrays on different schedules (steps vs the clock).
+    std::vector<std::size_t> by_id(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) by_id[p.id[i]] = i;
+    for (const std::size_t i : by_id) {
       if (p.kind[i] != static_cast<std::uint8_t>(ParticleKind::Fluid)) continue;
       s.front = std::max(s.front, static_cast<double>(p.x[i][0]));
       for (int d = 0; d < Dim; ++d) xs.push_back(static_cast<double>(p.x[i][d]));

@@ -147,14 +147,14 @@ TEST_F(CheckpointErrors, UnknownAndMissingFields) {
   const auto unknown = with([&](std::string& b) { b.replace(pos, 9, "viscosit2"); });
   EXPECT_NE(unknown.find("unknown field 'viscosit2'"), std::string::npos) << unknown;
 
-  // Drop the last field ("kind": 4-byte name length, name, size, count, data) and lower the count.
-  const auto lvl = good_.rfind("kind") - 4;
+  // Drop the last field ("id": 4-byte name length, name, size, count, data) and lower the count.
+  const auto lvl = good_.rfind(std::string("\x02\0\0\0id", 6));
   const auto missing = with([&](std::string& b) {
     const std::size_t nfields_at = 8 + 4 * 4 + 8 * 3 + 8 + 5;  // header, user blob "state"
     b[nfields_at] = static_cast<char>(b[nfields_at] - 1);
     b.erase(lvl, b.size() - 8 - lvl);
   });
-  EXPECT_NE(missing.find("missing field 'kind'"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("missing field 'id'"), std::string::npos) << missing;
 
   const auto dup = with([&](std::string& b) { b.replace(b.rfind("level"), 5, "phase"); });
   EXPECT_NE(dup.find("field 'phase' appears twice"), std::string::npos) << dup;

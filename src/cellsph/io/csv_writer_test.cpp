@@ -29,11 +29,12 @@ T parse(const std::string& s) {
 }
 
 TEST(CsvWriter, HeaderStartsWithTheContractColumns) {
-  EXPECT_EQ((csv_header<2, double>()),
-            "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind");
+  EXPECT_EQ(
+      (csv_header<2, double>()),
+      "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind,id");
   EXPECT_EQ((csv_header<3, float>()),
             "x,y,z,vx,vy,vz,density,pressure,phase,force_x,force_y,force_z,mass,support,color,viscosity,"
-            "level,tick,kind");
+            "level,tick,kind,id");
 }
 
 template <int Dim, class Real>

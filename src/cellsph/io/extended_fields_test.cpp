@@ -16,14 +16,14 @@ namespace {
 template <int Dim, class Real>
 struct ExtendedParticles : Particles<Dim, Real> {
   std::vector<std::uint8_t> flag;
-  std::vector<std::int64_t> id;
+  std::vector<std::int64_t> serial;
   std::vector<Vec<Dim, Real>> normal;
 
   template <class Self, class F>
   static void for_each_field(Self& self, F&& fn) {
     Particles<Dim, Real>::for_each_field(self, fn);
     fn(std::string_view("flag"), self.flag);
-    fn(std::string_view("id"), self.id);
+    fn(std::string_view("serial"), self.serial);
     fn(std::string_view("normal"), self.normal);
   }
   template <class F>
@@ -43,11 +43,11 @@ ExtendedParticles<2, float> make_extended(std::size_t n) {
   ExtendedParticles<2, float> e;
   static_cast<Particles<2, float>&>(e) = test::make_particles<2, float>(n);
   e.flag.resize(n);
-  e.id.resize(n);
+  e.serial.resize(n);
   e.normal.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     e.flag[i] = static_cast<std::uint8_t>(200 + i);
-    e.id[i] = (std::int64_t{1} << 40) + static_cast<std::int64_t>(i);
+    e.serial[i] = (std::int64_t{1} << 40) + static_cast<std::int64_t>(i);
     e.normal[i] = Vec<2, float>{{0.6f, -0.8f * static_cast<float>(i)}};
   }
   return e;
@@ -59,10 +59,10 @@ TEST(ExtendedFields, VtuHasTheNewArraysWithTheirTypes) {
   write_vtu_any(e, 0.0, dir / "e.vtu");
   const std::string text = test::slurp(dir / "e.vtu");
   EXPECT_NE(text.find("type=\"UInt8\" Name=\"flag\" NumberOfComponents=\"1\""), std::string::npos);
-  EXPECT_NE(text.find("type=\"Int64\" Name=\"id\" NumberOfComponents=\"1\""), std::string::npos);
+  EXPECT_NE(text.find("type=\"Int64\" Name=\"serial\" NumberOfComponents=\"1\""), std::string::npos);
   EXPECT_NE(text.find("type=\"Float32\" Name=\"normal\" NumberOfComponents=\"3\""), std::string::npos);
   // The id block: its offset from the header, then count and values.
-  const auto tag = text.find("Name=\"id\"");
+  const auto tag = text.find("Name=\"serial\"");
   const auto off_at = text.find("offset=\"", tag) + 8;
   const auto offset = std::stoull(text.substr(off_at, text.find('"', off_at) - off_at));
   const auto data = text.find('_', text.find("<AppendedData")) + 1;
@@ -77,10 +77,10 @@ TEST(ExtendedFields, VtuHasTheNewArraysWithTheirTypes) {
 TEST(ExtendedFields, CsvAppendsTheNewColumns) {
   test::TempDir dir("ext_csv");
   const auto e = make_extended(3);
-  EXPECT_EQ(
-      (csv_header_any<ExtendedParticles<2, float>>()),
-      "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind,flag,id,"
-      "normal_x,normal_y");
+  EXPECT_EQ((csv_header_any<ExtendedParticles<2, float>>()),
+            "x,y,vx,vy,density,pressure,phase,force_x,force_y,mass,support,color,viscosity,level,tick,kind,"
+            "id,flag,serial,"
+            "normal_x,normal_y");
   write_csv_any(e, dir / "e.csv", {});
   const std::string text = test::slurp(dir / "e.csv");
   const auto row2 = text.find('\n', text.find('\n', text.find('\n') + 1) + 1) + 1;  // third data row
@@ -95,7 +95,7 @@ TEST(ExtendedFields, CheckpointRoundTripAndFieldListMismatch) {
   ExtendedParticles<2, float> back;
   read_checkpoint_any(dir / "e.ckpt", back);
   EXPECT_EQ(back.flag, e.flag);
-  EXPECT_EQ(back.id, e.id);
+  EXPECT_EQ(back.serial, e.serial);
   EXPECT_EQ(back.normal, e.normal);
   EXPECT_EQ(back.x, e.x);
 

@@ -52,20 +52,27 @@ std::vector<std::filesystem::path> FrameOutput<Dim, Real>::write(const Particles
                                                                  std::size_t frame, double time) {
   std::vector<std::filesystem::path> written;
   FrameRow row{frame, time, {}};
+  const Particles<Dim, Real>* out = &particles;
+  CsvRowFilter keep = fluid_;
+  if (!in_id_order(particles)) {
+    copy_in_id_order(particles, ordered_, from_);
+    out = &ordered_;
+    if (fluid_) keep = [this](std::size_t k) { return fluid_(from_[k]); };
+  }
   // Frame files first, the indexes last: an index never names a file that is not complete.
   if (formats_.vtu) {
     row.files.push_back(frame_file_name(frame, "vtu"));
-    write_vtu(particles, time, dir_ / row.files.back());
+    write_vtu(*out, time, dir_ / row.files.back());
     written.push_back(dir_ / row.files.back());
   }
   if (formats_.ply) {
     row.files.push_back(frame_file_name(frame, "ply"));
-    write_ply(particles, time, dir_ / row.files.back());
+    write_ply(*out, time, dir_ / row.files.back());
     written.push_back(dir_ / row.files.back());
   }
   if (formats_.csv) {
     row.files.push_back(frame_file_name(frame, "csv"));
-    write_csv(particles, dir_ / row.files.back(), fluid_);
+    write_csv(*out, dir_ / row.files.back(), keep);
     written.push_back(dir_ / row.files.back());
   }
   if (formats_.vtu) pvd_.add(time, row.files.front());

@@ -4,6 +4,7 @@
 // `cellsph run` needs one call per frame, and a run killed at any moment leaves every listed frame
 // complete.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -25,7 +26,10 @@ class FrameOutput {
   // For --resume: reloads frames.csv and the .pvd and keeps the frames numbered below `next_frame`.
   void resume(std::size_t next_frame);
 
-  // Writes frame number `frame` at simulated time `time`; returns the files written (absolute).
+  // Writes frame number `frame` at simulated time `time`; returns the files written (absolute). The
+  // particles are written in id order (particle k of every file has id k, whatever order the Simulation
+  // keeps them in), so frames stay comparable row by row; the row filter is still asked with indices
+  // into `particles`.
   std::vector<std::filesystem::path> write(const Particles<Dim, Real>& particles, std::size_t frame,
                                            double time);
 
@@ -38,6 +42,8 @@ class FrameOutput {
   CsvRowFilter fluid_;
   FramesIndex index_;
   PvdWriter pvd_;
+  Particles<Dim, Real> ordered_;     // the particles in id order, when they are not already
+  std::vector<std::uint32_t> from_;  // index in the caller's particles of each of ordered_
 };
 
 }  // namespace cellsph

@@ -2,6 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
 #include "cellsph/core/error.hpp"
 #include "cellsph/io/io_test_util.hpp"
 
@@ -31,6 +37,48 @@ TEST(FrameOutput, WritesEveryFormatThenTheIndexes) {
   ASSERT_EQ(pvd.size(), 2u);
   EXPECT_EQ(pvd[1].file, "frame_00001.vtu");
   EXPECT_EQ(pvd[1].time, 0.05);
+}
+
+// The Simulation keeps its particles in cell order; frames are written in id order, with the row filter
+// still asked about the caller's indices (cmd_run's "is fluid" reads the simulation's own arrays).
+TEST(FrameOutput, WritesParticlesInIdOrder) {
+  test::TempDir dir("frames_ids");
+  const std::size_t n = 9;
+  const auto p = test::make_particles<2, double>(n);  // ids 0..8 in order
+  const std::vector<std::uint32_t> perm{4, 7, 0, 8, 2, 5, 1, 6, 3};
+  Particles<2, double> q;  // internal order: q[i] is the particle with id perm[i]
+  q.resize(n);
+  p.for_each_field([&](std::string_view name, const auto& src) {
+    q.for_each_field([&](std::string_view qname, auto& dst) {
+      if constexpr (std::is_same_v<std::remove_cvref_t<decltype(src)>, std::remove_cvref_t<decltype(dst)>>)
+        if (name == qname)
+          for (std::size_t i = 0; i < n; ++i) dst[i] = src[perm[i]];
+    });
+  });
+  ASSERT_FALSE(in_id_order(q));
+  // Drop the internal indices 1 and 4 (ids 7 and 2).
+  FrameOutput<2, double> out(dir.path(), parse_output_formats("csv"),
+                             [](std::size_t i) { return i != 1 && i != 4; });
+  out.write(q, 0, 0.0);
+  std::istringstream in(test::slurp(dir.path() / "frame_00000.csv"));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  for (std::stringstream hs(line); std::getline(hs, line, ',');) header.push_back(line);
+  const auto id_col =
+      static_cast<std::size_t>(std::find(header.begin(), header.end(), "id") - header.begin());
+  ASSERT_LT(id_col, header.size());
+  std::vector<std::uint32_t> ids;
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    for (std::stringstream ls(line); std::getline(ls, line, ',');) c.push_back(line);
+    ASSERT_EQ(c.size(), header.size());
+    const auto id = static_cast<std::uint32_t>(std::stoul(c[id_col]));
+    ids.push_back(id);
+    EXPECT_EQ(std::stod(c[0]), p.x[id][0]) << "row of id " << id;  // the row carries that particle's data
+    EXPECT_EQ(std::stod(c[2]), p.v[id][0]) << "row of id " << id;
+  }
+  EXPECT_EQ(ids, (std::vector<std::uint32_t>{0, 1, 3, 4, 5, 6, 8}));
 }
 
 TEST(FrameOutput, ResumeKeepsEarlierFramesAndDropsLaterOnes) {

@@ -35,6 +35,7 @@ Particles<Dim, Real> make_particles(std::size_t n) {
     p.mu[i] = Real(1e-3) * (Real(1) + t);
     p.phase[i] = static_cast<std::int32_t>(i % 3);
     p.level[i] = static_cast<std::int32_t>(i % 5) - 1;
+    p.id[i] = static_cast<std::uint32_t>(i);  // the identity: writers need not reorder
   }
   return p;
 }

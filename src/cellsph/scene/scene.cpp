@@ -220,6 +220,8 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
     cfg.search.subdivision = static_cast<int>(nr.integer("subdivision", 1, 1, 16));
     cfg.search.hash_table_size = static_cast<std::size_t>(nr.integer("hash_table_size", 0, 0, 1L << 40));
     cfg.verlet_skin = static_cast<Real>(nr.number("skin", double(cfg.verlet_skin), 0, 1));
+    cfg.reorder_every = static_cast<std::uint32_t>(
+        nr.integer("reorder_every", static_cast<long>(cfg.reorder_every), 0, 1000000));
     nr.finish();
   }
 

@@ -5,8 +5,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
+#include "cellsph/core/error.hpp"
 #include "cellsph/core/vec.hpp"
 
 namespace cellsph {
@@ -32,6 +35,10 @@ struct Particles {
   std::vector<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
   std::vector<std::int64_t> tick;   // per-particle steps: state time in units of dt_max / 2^max_level
   std::vector<std::uint8_t> kind;   // ParticleKind: fluid (integrated) or boundary (static, Akinci 2012)
+  // Persistent identity: a permutation of 0..n-1 that travels with the particle. The Simulation
+  // permutes the arrays into cell order (config reorder_every), so an index names a particle only
+  // between two reorders; the id names it for the whole run (outputs are written in id order).
+  std::vector<std::uint32_t> id;
 
   // The field list. f(name, vector) for every field, in a fixed order.
   template <class Self, class F>
@@ -49,6 +56,7 @@ struct Particles {
     fn(std::string_view("level"), self.level);
     fn(std::string_view("tick"), self.tick);
     fn(std::string_view("kind"), self.kind);
+    fn(std::string_view("id"), self.id);
   }
   template <class F>
   void for_each_field(F&& fn) {
@@ -64,5 +72,40 @@ struct Particles {
     for_each_field([n](std::string_view, auto& field) { field.resize(n); });
   }
 };
+
+// True when particle k has id k for every k (the order the outputs are written in).
+template <int Dim, class Real>
+bool in_id_order(const Particles<Dim, Real>& p) {
+  for (std::size_t k = 0; k < p.id.size(); ++k)
+    if (p.id[k] != k) return false;
+  return p.id.size() == p.size();
+}
+
+// dst = src with every field gathered into id order (dst particle k is the src particle with id k);
+// `from` receives the src index of each dst particle. The ids must be a permutation of 0..n-1.
+template <int Dim, class Real>
+void copy_in_id_order(const Particles<Dim, Real>& src, Particles<Dim, Real>& dst,
+                      std::vector<std::uint32_t>& from) {
+  const std::size_t n = src.size();
+  CELLSPH_CHECK(src.id.size() == n, "particle ids: " << src.id.size() << " for " << n << " particles");
+  constexpr std::uint32_t kNone = ~std::uint32_t{0};
+  from.assign(n, kNone);
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::uint32_t k = src.id[s];
+    CELLSPH_CHECK(k < n && from[k] == kNone,
+                  "particle ids are not a permutation: particle " << s << " has id " << k);
+    from[k] = static_cast<std::uint32_t>(s);
+  }
+  dst.resize(n);
+  Particles<Dim, Real>::for_each_field(src, [&](std::string_view name, const auto& field) {
+    Particles<Dim, Real>::for_each_field(dst, [&](std::string_view dname, auto& out) {
+      if constexpr (std::is_same_v<std::remove_cvref_t<decltype(field)>,
+                                   std::remove_cvref_t<decltype(out)>>) {
+        if (dname != name) return;
+        for (std::size_t k = 0; k < n; ++k) out[k] = field[from[k]];
+      }
+    });
+  });
+}
 
 }  // namespace cellsph

@@ -9,6 +9,8 @@
 #include <ostream>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <type_traits>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
@@ -23,6 +25,33 @@ namespace {
 
 constexpr std::uint8_t kFluid = static_cast<std::uint8_t>(ParticleKind::Fluid);
 constexpr std::uint8_t kBoundary = static_cast<std::uint8_t>(ParticleKind::Boundary);
+
+// Empty when `id` is a permutation of 0..n-1, otherwise what is wrong with it.
+std::string id_permutation_error(const std::vector<std::uint32_t>& id) {
+  std::vector<std::uint8_t> seen(id.size(), 0);
+  for (std::size_t i = 0; i < id.size(); ++i) {
+    if (id[i] >= id.size() || seen[id[i]]) {
+      std::ostringstream os;
+      os << "particle " << i << " has id " << id[i]
+         << (id[i] >= id.size() ? " (ids must be below the particle count " + std::to_string(id.size()) + ")"
+                                : " (another particle has it too)");
+      return os.str();
+    }
+    seen[id[i]] = 1;
+  }
+  return {};
+}
+
+// Z-order (Morton) key of a cell: the bits of the cell coordinates interleaved, so that cells close in
+// space are mostly close in the key and each block of 2^Dim, 4^Dim, ... cells is contiguous.
+template <int Dim>
+std::uint64_t morton_key(const std::uint64_t (&c)[Dim]) {
+  constexpr int bits = 64 / Dim;
+  std::uint64_t key = 0;
+  for (int b = 0; b < bits; ++b)
+    for (int a = 0; a < Dim; ++a) key |= ((c[a] >> b) & 1u) << (b * Dim + a);
+  return key;
+}
 
 }  // namespace
 
@@ -52,6 +81,15 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   p_.mu.assign(n, Real(0));
   complete(p_.level, "level", std::int32_t{0});
   complete(p_.tick, "tick", std::int64_t{0});
+  // Ids: empty, or all 0 as left by builders that resize the field list, mean the input order.
+  if (std::all_of(p_.id.begin(), p_.id.end(), [](std::uint32_t k) { return k == 0; })) p_.id.clear();
+  if (p_.id.empty()) {
+    CELLSPH_CHECK(n <= std::numeric_limits<std::uint32_t>::max(), n << " particles do not fit 32-bit ids");
+    p_.id.resize(n);
+    for (std::size_t i = 0; i < n; ++i) p_.id[i] = static_cast<std::uint32_t>(i);
+  }
+  complete(p_.id, "id", std::uint32_t{0});
+  if (const auto err = id_permutation_error(p_.id); !err.empty()) throw InputError("particles: " + err);
   rho0_.assign(n, Real(0));
 
   fluid_count_ = 0;
@@ -99,17 +137,24 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
   adami_walls_ = cfg_.wall_model == WallModel::Adami && fluid_count_ < n;
   f_pressure_.assign(n, V{});
-  init_boundary_weights();
   fluid_.clear();
   fluid_.reserve(fluid_count_);
+  IndexList boundary;
   // Default 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
   skin_ = cfg_.verlet_skin * cfg_.support;
   search_h_.assign(n, Real(0));
   for (std::size_t i = 0; i < n; ++i) {
-    if (p_.kind[i] != kFluid) continue;
+    if (p_.kind[i] != kFluid) {
+      boundary.push_back(static_cast<std::uint32_t>(i));
+      continue;
+    }
     fluid_.push_back(static_cast<std::uint32_t>(i));
     search_h_[i] = p_.h[i] + skin_;
   }
+  // Boundary particles never move: one reorder puts them in cell order for the whole run (before their
+  // weights, whose sums then run in that order too).
+  if (cfg_.reorder_every > 0) reorder_slots(boundary);
+  init_boundary_weights();
   lists_valid_ = false;
 }
 
@@ -145,6 +190,55 @@ void Simulation<Dim, Real>::init_boundary_weights() {
   });
 }
 
+// Cells of size h counted from the lowest corner of these particles, keyed in Z-order; equal keys by id.
+// The order is a function of positions and ids alone (a total order, so any sort gives it), which
+// keeps results independent of the neighbour method, the skin and the thread count. Particles move
+// only among `slots`, so every slot keeps its kind.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
+  const std::size_t m = slots.size();
+  if (m < 2) return;
+  V lo = p_.x[slots[0]];
+  for (const std::uint32_t i : slots)
+    for (int a = 0; a < Dim; ++a) lo[a] = std::min(lo[a], p_.x[i][a]);
+  const Real inv = Real(1) / cfg_.support;
+  constexpr std::uint64_t cmax = (std::uint64_t{1} << (64 / Dim)) - 1;
+  struct Item {
+    std::uint64_t key;
+    std::uint32_t id, slot;
+  };
+  std::vector<Item> items(m);
+  parallel_for(m, [&](std::size_t k) {
+    const std::uint32_t i = slots[k];
+    std::uint64_t c[Dim];
+    for (int a = 0; a < Dim; ++a) {
+      // Finite positions (check_state) at or above lo; far cells are clamped (only the order suffers).
+      const Real q = std::min(std::floor((p_.x[i][a] - lo[a]) * inv), static_cast<Real>(cmax));
+      c[a] = std::min(static_cast<std::uint64_t>(q), cmax);
+    }
+    items[k] = {morton_key<Dim>(c), p_.id[i], i};
+  });
+  std::sort(items.begin(), items.end(),
+            [](const Item& a, const Item& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
+  // Slot slots[k] receives the particle from slot items[k].slot.
+  auto permute = [&](auto& field) {
+    if (field.size() != p_.size()) return;  // a scratch array not in use
+    using T = typename std::remove_reference_t<decltype(field)>::value_type;
+    std::vector<T> tmp(m);
+    parallel_for(m, [&](std::size_t k) { tmp[k] = field[items[k].slot]; });
+    parallel_for(m, [&](std::size_t k) { field[slots[k]] = tmp[k]; });
+  };
+  p_.for_each_field([&](std::string_view, auto& field) { permute(field); });
+  // Every member array that persists between steps (the others are rebuilt before they are read).
+  permute(rho0_);
+  permute(search_h_);
+  permute(vol_);
+  permute(prho2_);
+  permute(f_pressure_);
+  permute(normal_);
+  lists_valid_ = false;  // x_built_ and the lists name the old slots
+}
+
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   // Boundary rows are never read by a step (j is a neighbour of i iff |x_i - x_j| <= h_i, so fluid rows
@@ -173,6 +267,29 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   ++timings_.list_builds;
 }
 
+// The rows of `set` cut down to the pairs within h_i, in the same (ascending) order: every pair loop
+// then runs without the skin test. That test is a branch taken for about a third of the candidates;
+// once the particles are in cell order (reorder_every) its pattern along a sorted row is irregular, and
+// the mispredictions cost more than this pass (which writes each candidate and advances by the test's
+// outcome, without a branch). The test is the one the loops made before: the same pairs, the same bits.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::filter_lists(const IndexList& set) {
+  within_.resize(nl_.indices.size());
+  within_count_.resize(p_.size());
+  for_each_of(set, [&](std::size_t i) {
+    const V xi = p_.x[i];
+    const Real hi2 = p_.h[i] * p_.h[i];
+    std::uint32_t* out = within_.data() + nl_.offsets[i];
+    std::uint32_t c = 0;
+    for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      const std::uint32_t j = *it;
+      out[c] = j;
+      c += distance2(xi, p_.x[j]) <= hi2 ? 1u : 0u;
+    }
+    within_count_[i] = c;
+  });
+}
+
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
@@ -183,7 +300,6 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
   with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
     for_each_of(set, [&](std::size_t i) {
       const V xi = p_.x[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
       Real rho = 0;
       if (number) {
         // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
@@ -191,19 +307,17 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
         // V_b / V_i fluid particles (V_i = m_i / rho0_i), so that with one phase this is eq. 7 exactly.
         Real delta = w.W2(0);
         const Real inv_vol_i = rho0_[i] / p_.m[i];
-        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        for (const auto* it = in_begin(i); it != in_end(i); ++it) {
           const std::uint32_t j = *it;
           const Real r2 = distance2(xi, p_.x[j]);
-          if (r2 > hi2) continue;  // in the Verlet skin only
           const Real wij = w.W2(r2);
           delta += p_.kind[j] == kFluid ? wij : wij * (p_.m[j] / rho0_[j]) * inv_vol_i;
         }
         rho = p_.m[i] * delta;
       } else {
         rho = density_term(w, p_.m[i], Real(0));
-        for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+        for (const auto* it = in_begin(i); it != in_end(i); ++it) {
           const Real r2 = distance2(xi, p_.x[*it]);
-          if (r2 > hi2) continue;  // in the Verlet skin only
           rho += density_term(w, p_.m[*it], r2);
         }
       }
@@ -234,10 +348,9 @@ void Simulation<Dim, Real>::compute_wall_states() {
   wall_start_.assign(n + 1, 0);
   auto each_wall_pair = [&](auto&& visit) {
     for_fluid([&](std::size_t f) {
-      const Real hf2 = p_.h[f] * p_.h[f];
-      for (const auto* it = nl_.begin(f); it != nl_.end(f); ++it) {
+      for (const auto* it = in_begin(f); it != in_end(f); ++it) {  // filter_lists: within h_f
         const std::uint32_t b = *it;
-        if (p_.kind[b] == kBoundary && distance2(p_.x[f], p_.x[b]) <= hf2) visit(f, b);
+        if (p_.kind[b] == kBoundary) visit(f, b);
       }
     });
   };
@@ -293,10 +406,9 @@ void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
   normal_.assign(p_.size(), V{});
   for_each_of(set, [&](std::size_t i) {
     V n{};
-    const Real hi2 = p_.h[i] * p_.h[i];
-    for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+    for (const auto* it = in_begin(i); it != in_end(i); ++it) {
       const std::uint32_t j = *it;
-      if (p_.kind[j] != kFluid || distance2(p_.x[i], p_.x[j]) > hi2) continue;
+      if (p_.kind[j] != kFluid) continue;
       n += wc.gradW(p_.x[i] - p_.x[j]) *
            (full ? p_.m[j] / p_.rho[j] : p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
     }
@@ -330,7 +442,6 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
       const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
       const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
       // CSF: kappa = -div(n / |n|) over neighbours with a defined normal, divided by their kernel sum
@@ -338,10 +449,9 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
       // interface) and underestimated the curvature by 17% (Laplace jump) whatever the resolution.
       Real kappa = 0, wsum = vol_i * wc.W2(0);
       const V vel_i = p_.v[i];
-      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      for (const auto* it = in_begin(i); it != in_end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
-        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
           // averaged_pressure_force and averaged_viscosity_force (eq. 8a, 8b), inlined with the
@@ -423,13 +533,11 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
       in.rhoi = p_.rho[i];
       in.pi = p_.p[i];
       in.mui = p_.mu[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
       const V vel_i = p_.v[i];
       const Real prho2_i = prho2_[i];
-      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
+      for (const auto* it = in_begin(i); it != in_end(i); ++it) {
         const std::uint32_t j = *it;
         in.xij = p_.x[i] - p_.x[j];
-        if (distance2(p_.x[i], p_.x[j]) > hi2) continue;  // in the Verlet skin only
         in.r = norm(in.xij);
         if (p_.kind[j] == kFluid) {
           // monaghan_viscosity_force and symmetric_pressure_force, inlined with one kernel gradient
@@ -576,7 +684,8 @@ void Simulation<Dim, Real>::check_state() const {
   const auto i = static_cast<std::size_t>(first);
   std::ostringstream os;
   os.precision(9);
-  os << "simulation unstable at step " << steps_ + 1 << " (t = " << time_ << " s): particle " << i << ": ";
+  os << "simulation unstable at step " << steps_ + 1 << " (t = " << time_ << " s): particle " << i << " (id "
+     << p_.id[i] << "): ";
   auto vec = [&](const char* name, const V& v) {
     os << name << " = (";
     for (int a = 0; a < Dim; ++a) os << (a ? ", " : "") << v[a];
@@ -685,6 +794,16 @@ void Simulation<Dim, Real>::step_per_particle() {
   if (T == std::numeric_limits<std::int64_t>::max()) T = 0;
 
   Stopwatch sw;
+  // Reorder on the clock, at multiples of reorder_every * dt_max: particles' steps are aligned to
+  // multiples of themselves, so there every particle is due (synchronised), and the schedule is a
+  // function of the ticks (checkpointed) alone.
+  const std::int64_t period = static_cast<std::int64_t>(cfg_.reorder_every) << L;
+  if (period > 0 && T % period == 0) {
+    reorder_slots(fluid_);
+    ++timings_.reorders;
+    timings_.reorder += sw.ms();
+    sw.reset();
+  }
   due_list_.clear();
   xs_ = p_.x;
   for (const std::uint32_t i : fluid_) {
@@ -698,6 +817,7 @@ void Simulation<Dim, Real>::step_per_particle() {
   timings_.neighbors += sw.ms();
   sw.reset();
   build_work_sets();
+  filter_lists(rho_set_);  // every pass below reads rows of rho_set_ only (it holds the other sets)
   compute_density_pressure(rho_set_);
   compute_forces_paper(due_list_, normal_set_);
   std::swap(p_.x, xs_);
@@ -747,10 +867,18 @@ void Simulation<Dim, Real>::step() {
     return;
   }
   Stopwatch sw;
+  // On the step count alone (checkpointed), never on the list rebuilds: see the header.
+  if (cfg_.reorder_every > 0 && steps_ % cfg_.reorder_every == 0) {
+    reorder_slots(fluid_);
+    ++timings_.reorders;
+    timings_.reorder += sw.ms();
+    sw.reset();
+  }
   compute_neighbors();
   timings_.neighbors += sw.ms();
 
   sw.reset();
+  filter_lists(fluid_);
   compute_density_pressure(fluid_);
   if (adami_walls_) compute_wall_states();
   if (cfg_.model == Model::PaperMultiphase)
@@ -810,6 +938,12 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
     throw InputError(source + ": holds " + std::to_string(n) + " particles, the scene has " +
                      std::to_string(p_.size()));
   }
+  if (particles.id.size() != n) {
+    throw InputError(source + ": holds " + std::to_string(particles.id.size()) + " particle ids for " +
+                     std::to_string(n) + " particles");
+  }
+  if (const auto err = id_permutation_error(particles.id); !err.empty())
+    throw InputError(source + ": " + err);
   for (std::size_t i = 0; i < n; ++i) {
     if (particles.phase[i] < 0 || static_cast<std::size_t>(particles.phase[i]) >= cfg_.phases.size() ||
         particles.kind[i] > kBoundary) {

@@ -10,6 +10,17 @@
 //
 // Determinism: every per-particle sum runs over the canonical CSR row (ascending neighbour index) on one
 // thread, so results are bit-identical for any thread count and any neighbour method.
+//
+// Particle order: every config.reorder_every steps the fluid particles are permuted into cell order
+// (Z-order of cells of size h, ties by id) among the fluid slots, so that the pair loops read
+// neighbours close in memory; with reordering on, the boundary particles are put in that order once at
+// construction. Kinds therefore keep their slots (fluid slots stay fluid), but particles() is in this
+// internal order: index i names a particle only until the next reorder. Follow a particle by its
+// particles().id (a permutation of 0..n-1, the input order unless given); copy_in_id_order()
+// (particles.hpp) gives the input order back, and the frame writers use it. The reorder schedule
+// depends only on the step count (or the clock, with per-particle steps) and the key only on
+// positions and ids, so results stay independent of the method, the skin and the thread count, and a
+// checkpoint (which holds the permuted order and the ids) resumes bit for bit.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -27,6 +38,8 @@ struct StepTimings {
   double forces = 0;              // density, pressure, forces
   double integration = 0;         // time step choice, integration, walls, stability check
   std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
+  double reorder = 0;             // permuting the particles into cell order (config reorder_every)
+  std::uint64_t reorders = 0;     // reorders run
   // Work done, in particles (summed over steps): a global step evaluates every fluid particle once; a
   // per-particle sub-step only the particles it integrates and those their forces read.
   std::uint64_t density_evals = 0;  // densities and pressures (eq. 7 + equation of state)
@@ -49,9 +62,10 @@ class Simulation {
   using V = Vec<Dim, Real>;
   using Config = SolverConfig<Dim, Real>;
 
-  // Validates the config (InputError) and completes the particles: x, v, m, phase and kind are the inputs
-  // (v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid particle:
-  // the phase's mass). support, colour and viscosity are set from the config and the phase table,
+  // Validates the config (InputError) and completes the particles: x, v, m, phase, kind and id are the
+  // inputs (id may be left empty or all 0: the input order; otherwise it must be a permutation of
+  // 0..n-1; v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid
+  // particle: the phase's mass). support, colour and viscosity are set from the config and the phase table,
   // density to the rest density; boundary particles with m == 0 get their Akinci weight psi_b in m (a
   // positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick,
   // m = rho0 spacing^Dim makes the wall look exactly like fluid).
@@ -67,6 +81,7 @@ class Simulation {
   [[nodiscard]] Real time() const { return time_; }
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   [[nodiscard]] Real last_dt() const { return last_dt_; }
+  // In the internal (cell) order: see "Particle order" above; particles().id names each particle.
   [[nodiscard]] const Particles<Dim, Real>& particles() const { return p_; }
   [[nodiscard]] const Config& config() const { return cfg_; }
   [[nodiscard]] const StepTimings& timings() const { return timings_; }
@@ -86,7 +101,8 @@ class Simulation {
   }
   // Replaces the particles and the integrator state. Throws InputError, prefixed with `source` (the
   // checkpoint file), when the particles do not fit this simulation: count, phase or kind not in its
-  // tables. The simulation is untouched on error.
+  // tables, ids not a permutation. The simulation is untouched on error. The particles keep their
+  // order (a checkpoint holds the internal order, so a resume is bit for bit).
   void restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state, const std::string& source);
 
   // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
@@ -99,7 +115,11 @@ class Simulation {
   // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
   // fluid rows, so boundary particles are then searched with support 0.
   void compute_neighbors(bool boundary_rows = false);
+  [[nodiscard]] const std::uint32_t* in_begin(std::size_t i) const { return within_.data() + nl_.offsets[i]; }
+  [[nodiscard]] const std::uint32_t* in_end(std::size_t i) const { return in_begin(i) + within_count_[i]; }
   using IndexList = std::vector<std::uint32_t>;
+  // The pairs of the rows of `set` within h (the Verlet lists hold h + skin): in_begin(i) .. in_end(i).
+  void filter_lists(const IndexList& set);
   template <class F>
   void for_fluid(F&& f) const;
   template <class F>
@@ -123,11 +143,16 @@ class Simulation {
   void init_boundary_weights();
   void step_per_particle();
   Real particle_dt(std::size_t i) const;
+  // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
+  // ties by id; every per-particle array is permuted and the Verlet lists invalidated.
+  void reorder_slots(const IndexList& slots);
 
   Config cfg_;
   Particles<Dim, Real> p_;
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
+  std::vector<std::uint32_t> within_;  // filter_lists: row i at nl_.offsets[i], within_count_[i] long
+  std::vector<std::uint32_t> within_count_;
   std::vector<V> normal_;      // CSF: colour gradient n_i of the current step
   std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
   std::vector<Real> rho0_;     // rest density per particle (from its phase)
@@ -148,11 +173,13 @@ class Simulation {
   IndexList boundary_;
   std::vector<std::uint32_t> wall_start_, wall_nbr_, wall_cursor_;
   std::vector<V> wall_v_;
-  std::vector<std::uint32_t> fluid_;  // indices of the fluid particles, ascending (kinds never change)
+  // Indices of the fluid particles, ascending. Kinds never change, and reordering permutes particles
+  // only among the slots of their own kind, so this list is fixed for a simulation.
+  std::vector<std::uint32_t> fluid_;
   // Verlet lists: the step's CSR lists hold the pairs within h + skin of the positions x_built_ and are
   // kept while no particle has moved more than 0.45 skin since (then every pair within h now was
-  // within h + skin then: triangle inequality). Every pair loop skips pairs with
-  // distance2(x_i, x_j) > h_i^2, the search's own test, so each sum runs over exactly the neighbours
+  // within h + skin then: triangle inequality). Each step filter_lists() cuts the rows to the pairs
+  // with distance2(x_i, x_j) <= h_i^2, the search's own test, so each sum runs over exactly the neighbours
   // an exact search gives, in the same (ascending) order: results do not depend on the skin, the
   // rebuild schedule, the method or a resume.
   std::vector<Real> search_h_;  // support per particle for the lists: h + skin (0 for boundary)

@@ -621,6 +621,24 @@ TEST(VerletLists, SkinChangesSearchCountNotResults) {
   }
   EXPECT_EQ(runs[0], runs[1]);
   EXPECT_EQ(runs[0], runs[2]);
+  // With reordering on too: the reorders follow the step count, not the list rebuilds.
+  std::vector<std::vector<V2>> reordered;
+  for (double skin : {0.0, 0.15, 0.5}) {
+    const double s = 0.1, rho0 = 1000;
+    SolverConfig<2, double> cfg = wcsph_water(s, 10 * std::sqrt(2 * 9.81 * 2));
+    cfg.verlet_skin = skin;
+    cfg.reorder_every = 25;
+    Particles<2, double> p;
+    add_block<2, double>(p, V2{{0, 0}}, V2{{1, 2}}, s, 0);
+    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{4, 3}}, s, 2, true, 0, rho0 * s * s);
+    Simulation<2, double> sim(cfg, std::move(p));
+    for (int k = 0; k < 300; ++k) sim.step();
+    EXPECT_EQ(sim.timings().reorders, 12u);
+    reordered.push_back(sim.particles().x);
+  }
+  EXPECT_EQ(reordered[0], reordered[1]);
+  EXPECT_EQ(reordered[0], reordered[2]);
+  EXPECT_NE(reordered[0], runs[0]);  // another order (and other last bits)
   EXPECT_EQ(builds[0], 300u);
   EXPECT_LT(builds[1], builds[0]);
   EXPECT_LT(builds[2], builds[1]);
