@@ -13,26 +13,14 @@
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/simulation.hpp"
+#include "cellsph/solver/solver_test_util.hpp"
 
 namespace cellsph {
 namespace {
 
 using V2 = Vec<2, double>;
 
-template <int Dim, class Real>
-bool same_state(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
-  bool same = a.size() == b.size();
-  a.for_each_field([&](std::string_view name, const auto& fa) {
-    b.for_each_field([&](std::string_view nb, const auto& fb) {
-      if constexpr (std::is_same_v<decltype(fa), decltype(fb)>) {
-        if (name == nb)
-          same = same && fa.size() == fb.size() &&
-                 std::memcmp(fa.data(), fb.data(), fa.size() * sizeof(fa[0])) == 0;
-      }
-    });
-  });
-  return same;
-}
+using test::same_state;
 
 // A 2D dam break (WCSPH as the scenes set it up): a 1 x 2 column in a 4 x 3 tank of boundary particles.
 // The column collapses and spreads, so particles travel far from their input neighbours.

@@ -16,6 +16,7 @@
 #include "cellsph/solver/boundaries.hpp"
 #include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/simulation.hpp"
+#include "cellsph/solver/solver_test_util.hpp"
 
 namespace cellsph {
 namespace {
@@ -79,20 +80,7 @@ SolverConfig<2, double> wcsph_water(double s, double c) {
   return cfg;
 }
 
-template <int Dim, class Real>
-bool same_state(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
-  bool same = a.size() == b.size();
-  a.for_each_field([&](std::string_view name, const auto& fa) {
-    b.for_each_field([&](std::string_view nb, const auto& fb) {
-      if constexpr (std::is_same_v<decltype(fa), decltype(fb)>) {
-        if (name == nb)
-          same = same && fa.size() == fb.size() &&
-                 std::memcmp(fa.data(), fb.data(), fa.size() * sizeof(fa[0])) == 0;
-      }
-    });
-  });
-  return same;
-}
+using test::same_state;
 
 class BothModels : public ::testing::TestWithParam<Model> {};
 
