@@ -37,12 +37,12 @@ TEST(BenchCli, StepsComparesPerParticleWithTheGlobalStep) {
   TempDir dir;
   // The 2D dam break with the paper model, 0.1 m spacing (200 particles), c = 3 m/s, Akinci walls (the
   // scene's Adami walls need global steps).
-  const auto r =
-      run_cli(dir,
-              "bench steps --scene dam-break-2d --set '/solver/model=\"paper\"' --set '/boundary/model=\"akinci\"' "
-              "--set /spacing=0.1 "
-              "--set /solver/support=0.2 --set /phases/0/viscosity=0.5 --set /solver/eos/stiffness=9000 "
-              "--dt-max 0.01 --end 0.2 --sample 0.1 --threads 2");
+  const auto r = run_cli(
+      dir,
+      "bench steps --scene dam-break-2d --set '/solver/model=\"paper\"' --set '/boundary/model=\"akinci\"' "
+      "--set /spacing=0.1 "
+      "--set /solver/support=0.2 --set /phases/0/viscosity=0.5 --set /solver/eos/stiffness=9000 "
+      "--dt-max 0.01 --end 0.2 --sample 0.1 --threads 2");
   ASSERT_EQ(r.code, 0) << r.err;
   const Row g = row(r.out, "courant"), pp = row(r.out, "per-particle"), all = row(r.out, "per-particle/all");
   ASSERT_TRUE(g.found && pp.found && all.found) << r.out;

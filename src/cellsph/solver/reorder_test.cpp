@@ -25,21 +25,7 @@ using test::same_state;
 // A 2D dam break (WCSPH as the scenes set it up): a 1 x 2 column in a 4 x 3 tank of boundary particles.
 // The column collapses and spreads, so particles travel far from their input neighbours.
 SolverConfig<2, double> dam_config(double s, std::uint32_t reorder_every) {
-  const double rho0 = 1000, c = 10 * std::sqrt(2 * 9.81 * 2);
-  SolverConfig<2, double> cfg;
-  cfg.model = Model::Wcsph;
-  cfg.search.method = Method::CellIndex;
-  cfg.density_kernel = KernelKind::CubicSpline;
-  cfg.pressure_kernel = KernelKind::CubicSpline;
-  cfg.support = 2 * s;
-  cfg.phases[0].rest_density = rho0;
-  cfg.phases[0].mass = rho0 * s * s;
-  cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / 8;
-  cfg.eos.kind = EosKind::Ratio;
-  cfg.eos.stiffness = rho0 * c * c;
-  cfg.eos.clamp_negative = true;
-  cfg.time.mode = TimeStepping::Courant;
-  cfg.time.dt_max = 1e-3;
+  SolverConfig<2, double> cfg = test::wcsph_water(s, 10 * std::sqrt(2 * 9.81 * 2));
   cfg.reorder_every = reorder_every;
   return cfg;
 }

@@ -58,27 +58,7 @@ SolverConfig<2, double> base_config(Model model) {
   return c;
 }
 
-// 2D WCSPH water as the dam-break scenes set it up: cubic kernels, h = 2 spacings, ratio EOS with sound
-// speed c, clamped negative pressure, the artificial viscosity mu = rho0 alpha h c / (2 (d + 2)) with
-// alpha = 0.02, Courant steps.
-SolverConfig<2, double> wcsph_water(double s, double c) {
-  const double rho0 = 1000;
-  SolverConfig<2, double> cfg;
-  cfg.model = Model::Wcsph;
-  cfg.search.method = Method::CellIndex;
-  cfg.density_kernel = KernelKind::CubicSpline;
-  cfg.pressure_kernel = KernelKind::CubicSpline;
-  cfg.support = 2 * s;
-  cfg.phases[0].rest_density = rho0;
-  cfg.phases[0].mass = rho0 * s * s;
-  cfg.phases[0].viscosity = rho0 * 0.02 * cfg.support * c / (2 * (2 + 2));
-  cfg.eos.kind = EosKind::Ratio;
-  cfg.eos.stiffness = rho0 * c * c;
-  cfg.eos.clamp_negative = true;
-  cfg.time.mode = TimeStepping::Courant;
-  cfg.time.dt_max = 1e-3;
-  return cfg;
-}
+using test::wcsph_water;
 
 using test::same_state;
 
