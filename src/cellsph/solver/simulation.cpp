@@ -139,13 +139,13 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   f_pressure_.assign(n, V{});
   fluid_.clear();
   fluid_.reserve(fluid_count_);
-  IndexList boundary;
+  boundary_.clear();
   // Default 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
   skin_ = cfg_.verlet_skin * cfg_.support;
   search_h_.assign(n, Real(0));
   for (std::size_t i = 0; i < n; ++i) {
     if (p_.kind[i] != kFluid) {
-      boundary.push_back(static_cast<std::uint32_t>(i));
+      boundary_.push_back(static_cast<std::uint32_t>(i));
       continue;
     }
     fluid_.push_back(static_cast<std::uint32_t>(i));
@@ -153,7 +153,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   }
   // Boundary particles never move: one reorder puts them in cell order for the whole run (before their
   // weights, whose sums then run in that order too).
-  if (cfg_.reorder_every > 0) reorder_slots(boundary);
+  if (cfg_.reorder_every > 0) reorder_slots(boundary_);
   init_boundary_weights();
   lists_valid_ = false;
 }
@@ -341,9 +341,6 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_wall_states() {
   const std::size_t n = p_.size();
-  boundary_.clear();
-  for (std::size_t i = 0; i < n; ++i)
-    if (p_.kind[i] == kBoundary) boundary_.push_back(static_cast<std::uint32_t>(i));
   if (boundary_.empty()) return;
   wall_start_.assign(n + 1, 0);
   auto each_wall_pair = [&](auto&& visit) {
@@ -954,10 +951,11 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   }
   p_ = std::move(particles);
   fluid_.clear();
+  boundary_.clear();
   for (std::size_t i = 0; i < p_.size(); ++i) {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
     const bool fluid = p_.kind[i] == kFluid;
-    if (fluid) fluid_.push_back(static_cast<std::uint32_t>(i));
+    (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
     search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
   }
   fluid_count_ = fluid_.size();

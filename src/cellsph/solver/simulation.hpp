@@ -166,11 +166,12 @@ class Simulation {
   IndexList due_list_, normal_set_, rho_set_;
   std::vector<std::uint8_t> mark_;  // per particle: 1 density needed, 2 normal needed
   bool full_passes_ = false;
-  // Adami walls, rebuilt every step (nothing kept across steps, so the particle arrays may be reordered):
-  // the boundary particles, the fluid neighbours of each (CSR by particle index, ascending within a
-  // row: wall_start_[b] .. wall_start_[b + 1] into wall_nbr_, gathered from the fluid rows) and the
-  // extrapolated wall velocity of the no-slip term.
+  // Indices of the boundary particles, ascending; fixed for a simulation like fluid_ (set with it).
   IndexList boundary_;
+  // Adami walls, rebuilt every step (nothing kept across steps, so the particle arrays may be reordered):
+  // the fluid neighbours of each boundary particle (CSR by particle index, ascending within a row:
+  // wall_start_[b] .. wall_start_[b + 1] into wall_nbr_, gathered from the fluid rows) and the
+  // extrapolated wall velocity of the no-slip term.
   std::vector<std::uint32_t> wall_start_, wall_nbr_, wall_cursor_;
   std::vector<V> wall_v_;
   // Indices of the fluid particles, ascending. Kinds never change, and reordering permutes particles
