@@ -267,8 +267,8 @@ class CellIndex {
   [[nodiscard]] std::size_t memory_bytes() const {
     std::size_t s = cells_.capacity() * sizeof(std::uint64_t) +
                     cell_start_.capacity() * sizeof(std::uint32_t) + hs_.capacity() * sizeof(Real) +
-                    ids_.capacity() * sizeof(std::uint32_t) + deltas_.capacity() * sizeof(std::uint64_t) +
-                    mask_.capacity() * sizeof(MaskCell<Dim>);
+                    zero_cell_.capacity() + ids_.capacity() * sizeof(std::uint32_t) +
+                    deltas_.capacity() * sizeof(std::uint64_t) + mask_.capacity() * sizeof(MaskCell<Dim>);
     for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
     return s;
   }
@@ -299,6 +299,7 @@ class CellIndex {
     cell_start_.clear();
     for (auto& v : xs_) v.clear();
     hs_.clear();
+    zero_cell_.clear();
     ids_.clear();
     wide_ = force_wide_;
     index_bits_ = cell_bits_ = 0;
@@ -416,6 +417,15 @@ class CellIndex {
       const std::uint32_t i = ids_[p];
       for (int k = 0; k < Dim; ++k) xs_[k][p] = x[i][k];
       hs_[p] = h[i];
+    });
+    // Cells whose particles all have support 0 (the solver's wall particles, which need no rows).
+    const std::size_t nc = cell_count();
+    zero_cell_.assign(nc, 0);
+    if (uniform_h_ && hmax_ > 0) return;
+    parallel_for(nc, [&](std::size_t u) {
+      bool zero = true;
+      for (std::uint32_t p = cell_start_[u]; p < cell_start_[u + 1]; ++p) zero = zero && hs_[p] == 0;
+      zero_cell_[u] = zero ? 1 : 0;
     });
   }
 
@@ -627,6 +637,18 @@ class CellIndex {
             static_cast<std::uint32_t>(std::lower_bound(cells, cells + nc, cells[u0] + deltas_[m]) - cells);
       std::uint64_t local_tests = 0;
       for (std::size_t u = u0; u < u1; ++u) {
+        if (zero_cell_[u]) {
+          // Support 0: the neighbours are the points at distance 0, which share the home cell (a
+          // cell is a function of the position). The cursors skip this cell; the next cell's
+          // update catches them up.
+          const Range home_only{start[u], start[u + 1], 0};
+          const std::uint32_t len = home_only.end - home_only.begin;
+          for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
+            local_tests += len - 1;
+            kernel(p, own_buf.template fill<WithIds>(*this, &home_only, 1, len));
+          }
+          continue;
+        }
         const std::uint64_t home = cells[u];
         int nf = 0;
         for (std::size_t m = 0; m < M; ++m) {
@@ -712,6 +734,7 @@ class CellIndex {
   std::vector<std::uint32_t> cell_start_;  // first particle (key order) of each cell, + n
   std::array<std::vector<Real>, Dim> xs_;  // positions in key order, one array per axis
   std::vector<Real> hs_;                   // support lengths in key order
+  std::vector<std::uint8_t> zero_cell_;    // 1: every particle of the cell has support 0
   std::vector<std::uint32_t> ids_;         // key order -> particle index
 };
 

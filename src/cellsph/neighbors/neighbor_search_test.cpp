@@ -284,6 +284,25 @@ TEST_P(CrossMethod, DuplicatePoints) {
   });
 }
 
+// The solver's walls: particles of support 0 (no rows but their exact duplicates) next to particles
+// of support 1. Whole cells of support 0 (the first 35% along axis 0), cells that mix both (up to 60%,
+// and the duplicates), and cells of support 1 beyond, so a traversal passes from skipped cells to full ones.
+TEST_P(CrossMethod, ZeroSupportRegions) {
+  for_all_types([&]<int Dim, class Real>() {
+    const auto base = lattice<Dim, Real>(600, 0.5, 0.3, 14);
+    Points<Dim, Real> x(base.begin(), base.end());
+    x.insert(x.end(), base.begin(), base.begin() + 100);  // duplicates of some points
+    double top = 0;
+    for (const auto& p : x) top = std::max(top, double(p[0]));
+    std::vector<Real> h(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const double a = double(x[i][0]) / top;
+      h[i] = a < 0.35 || (a < 0.6 && i % 2 == 0) ? Real(0) : Real(1);
+    }
+    expect_exact<Dim, Real>(GetParam(), x, h);
+  });
+}
+
 TEST_P(CrossMethod, OnePointAndZeroPoints) {
   for_all_types([&]<int Dim, class Real>() {
     Points<Dim, Real> one(1);

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/physics/kernels.hpp"
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/solver/initial.hpp"
 
@@ -67,6 +68,78 @@ struct Aabb {
   std::vector<double> lo, hi;
 };
 
+// Length of the ray x + t d (t >= 0) inside the box (slab method).
+template <int Dim>
+double ray_length_in(const Aabb<Dim>& b, const std::array<double, Dim>& x, const std::array<double, Dim>& d) {
+  double t0 = 0, t1 = std::numeric_limits<double>::infinity();
+  for (std::size_t a = 0; a < Dim; ++a) {
+    if (d[a] == 0) {
+      if (x[a] < b.lo[a] || x[a] > b.hi[a]) return 0;
+      continue;
+    }
+    const double u = (b.lo[a] - x[a]) / d[a], v = (b.hi[a] - x[a]) / d[a];
+    t0 = std::max(t0, std::min(u, v));
+    t1 = std::min(t1, std::max(u, v));
+  }
+  return std::max(0.0, t1 - t0);
+}
+
+// sum_k W(|k| spacing) over the whole lattice (k integer, self included): the summation density of a
+// lattice site inside the fluid is m times this, which differs from 1 / spacing^Dim by a fraction of a
+// percent (enough for a pressure of the order of rho0 g H at the dam breaks' sound speed).
+template <int Dim, class Real>
+double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, double spacing) {
+  const int K = static_cast<int>(std::ceil(double(cfg.support) / spacing));
+  double sum = 0;
+  with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
+    std::array<int, Dim> k;
+    k.fill(-K);
+    while (true) {
+      double r2 = 0;
+      for (int a = 0; a < Dim; ++a) r2 += double(k[a]) * double(k[a]) * spacing * spacing;
+      sum += double(w.W2(static_cast<Real>(r2)));
+      int a = 0;
+      while (a < Dim && ++k[a] > K) k[a++] = -K;
+      if (a == Dim) break;
+    }
+  });
+  return sum;
+}
+
+// Fluid at rest under gravity: every fluid particle gets the pressure of the fluid above it,
+// p = |g| sum_b rho0_b L_b (L_b: the length of the ray from the particle against gravity inside fluid
+// block b), and the mass at which the summation density of its lattice site is the state equation's
+// density for p: m = rho(p) / lattice_kernel_sum. A column then starts in equilibrium instead of
+// falling onto itself while its pressure builds (and without the uniform pressure that the lattice
+// sum's bias gives with m = rho0 spacing^Dim). Blocks do not overlap; walls and obstacles above carry no
+// weight. A phase whose mass the scene sets keeps it.
+template <int Dim, class Real>
+void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& cfg, double spacing,
+                       const std::vector<bool>& mass_given, const std::vector<Aabb<Dim>>& blocks,
+                       const std::vector<std::int32_t>& block_phase) {
+  double g2 = 0;
+  for (int a = 0; a < Dim; ++a) g2 += double(cfg.gravity[a]) * double(cfg.gravity[a]);
+  const double g = std::sqrt(g2);
+  const double volume = 1 / lattice_kernel_sum(cfg, spacing);
+  std::array<double, Dim> up{};
+  for (int a = 0; a < Dim; ++a) up[static_cast<std::size_t>(a)] = g > 0 ? -double(cfg.gravity[a]) / g : 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != static_cast<std::uint8_t>(ParticleKind::Fluid)) continue;
+    std::array<double, Dim> x{};
+    for (int a = 0; a < Dim; ++a) x[static_cast<std::size_t>(a)] = double(p.x[i][a]);
+    double pressure = 0;
+    if (g > 0)
+      for (std::size_t b = 0; b < blocks.size(); ++b)
+        pressure += g * double(cfg.phases[static_cast<std::size_t>(block_phase[b])].rest_density) *
+                    ray_length_in<Dim>(blocks[b], x, up);
+    const auto ph = static_cast<std::size_t>(p.phase[i]);
+    const Real rho0 = cfg.phases[ph].rest_density;
+    const double rho = double(cfg.eos.density(static_cast<Real>(pressure), rho0));
+    p.m[i] = mass_given[ph] ? static_cast<Real>(double(cfg.phases[ph].mass) * rho / double(rho0))
+                            : static_cast<Real>(rho * volume);
+  }
+}
+
 template <int Dim>
 Aabb<Dim> read_box(JsonReader& r) {
   Aabb<Dim> b{r.required_vector("min", Dim), r.required_vector("max", Dim)};
@@ -121,6 +194,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
 
   // --- phases ---------------------------------------------------------------------------------
   std::vector<std::string> phase_names;
+  std::vector<bool> mass_given;  // phases[k].mass set by the scene
   if (r.has("phases")) {
     cfg.phases.clear();
     auto pr = r.child("phases");
@@ -137,6 +211,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
       ph.color = static_cast<Real>(e.number("color", 1, -1e9, 1e9));
       ph.sigma = static_cast<Real>(e.number("sigma", 0, 0, 1e9));
       e.finish();
+      mass_given.push_back(ph.mass != 0);
       if (ph.mass == 0) ph.mass = ph.rest_density * static_cast<Real>(std::pow(spacing, Dim));
       phase_names.push_back(ph.name);
       cfg.phases.push_back(ph);
@@ -144,6 +219,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   } else {
     cfg.phases[0].mass = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
     phase_names.push_back(cfg.phases[0].name);
+    mass_given.push_back(false);
   }
   auto read_phase = [&](JsonReader& e) -> std::int32_t {
     if (!e.has("phase")) return 0;
@@ -324,6 +400,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   const std::size_t nf = fr.array_size();
   if (nf == 0) fr.fail_here("at least one fluid block is needed");
   std::vector<Aabb<Dim>> blocks;
+  std::vector<std::int32_t> block_phase;
   const double tol = 1e-9 * spacing;
   for (std::size_t k = 0; k < nf; ++k) {
     auto e = fr.element(k);
@@ -346,11 +423,14 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
         e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
     if (container && !inside<Dim>(b, *container, tol)) e.fail_here("lies (partly) outside the boundary box");
     blocks.push_back(b);
+    block_phase.push_back(phase);
     const std::size_t first = p.size();
     add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
     for (std::size_t i = first; i < p.size(); ++i) p.v[i] = vel;
     if (p.size() > (std::size_t{1} << 31)) e.fail_here("more than 2^31 particles");
   }
+  if (r.choice("initial_pressure", "zero", {"zero", "hydrostatic"}) == "hydrostatic")
+    start_hydrostatic(p, cfg, spacing, mass_given, blocks, block_phase);
 
   // --- output ---------------------------------------------------------------------------------
   if (r.has("output")) {
