@@ -141,7 +141,8 @@ TankRun run_tank(const std::string& start) {
     if (p.kind[i] != 0) continue;
     const double x = p.x[i][0], y = p.x[i][1];
     if (x < h || x > H - h || y < h || y > H - h) continue;  // the walls' and the surface's reach
-    out.worst_pressure_error = std::max(out.worst_pressure_error, std::abs(p.p[i] - 1000 * kG * (H - y)) / scale);
+    out.worst_pressure_error =
+        std::max(out.worst_pressure_error, std::abs(p.p[i] - 1000 * kG * (H - y)) / scale);
   }
   for (int s = 1; s < 300; ++s) sim.step();
   for (std::size_t i = 0; i < p.size(); ++i)

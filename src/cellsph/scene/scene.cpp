@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <limits>
 
-#include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/physics/kernels.hpp"
+#include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/solver/initial.hpp"
 
