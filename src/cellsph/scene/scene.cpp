@@ -308,7 +308,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   if (r.has("boundary")) {
     auto br = r.child("boundary");
     cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
-    cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami"}));
+    cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic"}));
     if (br.has("box")) {
       auto bx = br.child("box");
       const auto b = read_box<Dim>(bx);

@@ -55,8 +55,9 @@ void SolverConfig<Dim, Real>::validate() const {
   if (time.mode == TimeStepping::PerParticle && model != Model::PaperMultiphase)
     bad("time.mode", "per-particle", "per-particle steps need the paper model's leap-frog (model = paper)");
   // Wall states are computed from all fluid densities of a step; a per-particle sub-step has only some.
-  if (wall_model == WallModel::Adami && time.mode == TimeStepping::PerParticle)
-    bad("boundary.model", "adami", "needs global steps (time.mode fixed or courant), not per-particle");
+  if (wall_model != WallModel::Akinci && time.mode == TimeStepping::PerParticle)
+    bad("boundary.model", wall_model_name(wall_model),
+        "needs global steps (time.mode fixed or courant), not per-particle");
   if (box.enabled) {
     for (int a = 0; a < Dim; ++a)
       if (!(box.hi[a] - 2 * box.radius > box.lo[a]))
@@ -116,11 +117,20 @@ std::optional<StepChangeCorrection> parse_correction(std::string_view n) {
   return std::nullopt;
 }
 std::string_view wall_model_name(WallModel w) {
-  return w == WallModel::Akinci ? "akinci" : "adami";
+  switch (w) {
+    case WallModel::Akinci:
+      return "akinci";
+    case WallModel::Adami:
+      return "adami";
+    case WallModel::Dynamic:
+      return "dynamic";
+  }
+  return "?";
 }
 std::optional<WallModel> parse_wall_model(std::string_view n) {
   if (n == "akinci") return WallModel::Akinci;
   if (n == "adami") return WallModel::Adami;
+  if (n == "dynamic") return WallModel::Dynamic;
   return std::nullopt;
 }
 std::string_view density_formulation_name(DensityFormulation d) {

@@ -67,7 +67,15 @@ enum class WallModel {
   // fluid neighbours' pressures plus the hydrostatic term (their eq. 27), its density from that pressure
   // through the equation of state, and for no slip the velocity 2 v_wall - (kernel average of the fluid
   // velocities) (their eq. 22-23); the fluid-wall forces are then ordinary symmetric pair terms.
+  // p_w is not a function of the wall's own kernel-sampled density, so its force is not the gradient of
+  // an energy: in a weakly viscous closed box it does net positive work (docs/physics.md).
   Adami,
+  // Dynamic boundary particles (Crespo, Gomez-Gesteira & Dalrymple 2007), with summation density: each wall
+  // particle is a fluid particle held at rest, rho_w = sum_k m_k W_wk over its fluid and wall neighbours
+  // (itself included) and p_w = EOS(rho_w); the pair forces are the fluid's. Forces are then minus the
+  // gradient of the total internal energy, fluid and walls (Monaghan 2005's Lagrangian with the wall
+  // positions fixed), so walls do no net work. No slip: viscosity against a wall at rest.
+  Dynamic,
 };
 
 // One fluid (or boundary material): the phases table of a scene.

@@ -135,7 +135,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
     }
   }
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
-  adami_walls_ = cfg_.wall_model == WallModel::Adami && fluid_count_ < n;
+  adami_walls_ = cfg_.wall_model != WallModel::Akinci && fluid_count_ < n;
   f_pressure_.assign(n, V{});
   fluid_.clear();
   fluid_.reserve(fluid_count_);
@@ -186,6 +186,17 @@ void Simulation<Dim, Real>::init_boundary_weights() {
       for (const auto* it = nl_.begin(b); it != nl_.end(b); ++it)
         if (p_.kind[*it] == kBoundary) s += w.W2(distance2(p_.x[b], p_.x[*it]));
       p_.m[b] = rho0_[b] / s;
+    });
+    // Dynamic walls: the wall-wall part of each wall's summation density, fixed for the run (weights
+    // first: a neighbour's weight may have just been set above). Summed in row order (ascending).
+    if (cfg_.wall_model != WallModel::Dynamic) return;
+    wall_self_rho_.assign(p_.size(), Real(0));
+    parallel_for(p_.size(), [&](std::size_t b) {
+      if (p_.kind[b] != kBoundary) return;
+      Real s = p_.m[b] * w.W2(0);
+      for (const auto* it = nl_.begin(b); it != nl_.end(b); ++it)
+        if (p_.kind[*it] == kBoundary) s += p_.m[*it] * w.W2(distance2(p_.x[b], p_.x[*it]));
+      wall_self_rho_[b] = s;
     });
   });
 }
@@ -368,6 +379,22 @@ void Simulation<Dim, Real>::compute_wall_states() {
       std::uint32_t* first = wall_nbr_.data() + wall_start_[b];
       std::uint32_t* last = wall_nbr_.data() + wall_start_[b + 1];
       std::sort(first, last);
+      if (cfg_.wall_model == WallModel::Dynamic) {
+        // A fluid particle held at rest: summation density (its fixed wall part, then the fluid in
+        // ascending index) and the fluid's EOS, never below 0: the outer layers lack neighbours beyond
+        // them, and an unclamped EOS would make them pull the fluid in. Any p_w(rho_w) is the derivative
+        // of a wall energy (here the clamped EOS's), so the forces stay conservative.
+        Real rho = wall_self_rho_[b];
+        for (const std::uint32_t* it = first; it != last; ++it)
+          rho += density_term(w, p_.m[*it], distance2(p_.x[b], p_.x[*it]));
+        const Real pw = std::max(Real(0), cfg_.eos.pressure(rho, rho0_[b]));
+        p_.p[b] = pw;
+        p_.rho[b] = rho;
+        vol_[b] = p_.m[b] / rho;
+        prho2_[b] = pw / (rho * rho);
+        wall_v_[b] = p_.v[b];
+        return;
+      }
       Real wsum = 0, psum = 0;
       V rsum{}, vsum{};
       for (const std::uint32_t* it = first; it != last; ++it) {
@@ -960,6 +987,8 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   }
   fluid_count_ = fluid_.size();
   lists_valid_ = false;
+  // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder).
+  if (cfg_.wall_model == WallModel::Dynamic) init_boundary_weights();
   time_ = state.time;
   last_dt_ = state.last_dt;
   steps_ = state.steps;

@@ -174,6 +174,9 @@ class Simulation {
   // extrapolated wall velocity of the no-slip term.
   std::vector<std::uint32_t> wall_start_, wall_nbr_, wall_cursor_;
   std::vector<V> wall_v_;
+  // WallModel::Dynamic: sum_c m_c W_wc over the wall particles c within h of wall w (w itself included),
+  // the constant part of w's summation density (walls never move); 0 for fluid slots.
+  std::vector<Real> wall_self_rho_;
   // Indices of the fluid particles, ascending. Kinds never change, and reordering permutes particles
   // only among the slots of their own kind, so this list is fixed for a simulation.
   std::vector<std::uint32_t> fluid_;
@@ -188,7 +191,9 @@ class Simulation {
   Real skin_ = 0;
   bool lists_valid_ = false;
   bool any_tension_ = false;
-  bool adami_walls_ = false;  // WallModel::Adami and there are boundary particles
+  // WallModel::Adami or Dynamic and there are boundary particles: walls carry their own p, rho (and
+  // velocity for no slip), computed each step by compute_wall_states.
+  bool adami_walls_ = false;
   std::size_t fluid_count_ = 0;
 
   // Integrator state (integrator_state(), restore()).
