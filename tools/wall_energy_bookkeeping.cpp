@@ -1,8 +1,7 @@
-// One-off diagnostic (not part of the CMake build): the set-up of
+// Diagnostic (target cellsph_wall_energy, built with the tests): the set-up of
 // Walls/WallModels.WeaklyViscousBoxHoldsTenThousandSteps with energy bookkeeping per force term
-// (docs/physics.md, "Scene stability"). Build against a configured build directory:
-//   g++ -std=c++20 -O2 -fopenmp -Isrc scripts/diagnostics/wall_energy_bookkeeping.cpp build/libcellsph.a -o wall_energy
-//   ./wall_energy wcsph|paper akinci|adami|dynamic [courant 0.3] [steps 10000] [mu 0.5]
+// (docs/physics.md, "Scene stability"):
+//   build/cellsph_wall_energy wcsph|paper akinci|adami|dynamic [courant 0.3] [steps 10000] [mu 0.5]
 // Columns: E - E0, kinetic energy, work of the wall's own pressure term (Adami/dynamic: p_w / rho_w^2;
 // Akinci: the mirrored p_b / rho_i^2), its split into the kernel-averaged and the hydrostatic part, the
 // work of the fluid's own wall term (p_i / rho_i^2, conservative), of the viscosity (WCSPH only), and the
