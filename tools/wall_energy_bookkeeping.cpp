@@ -77,8 +77,8 @@ int main(int argc, char** argv) {
   std::vector<V2> x0(n), v0(n), xprev(n), dxs(n);
   bool have_prev = false;
   std::vector<double> frac(n, 0);
-  std::printf("# model %s walls %s courant %g mu %g  mgH %.2f E0 %.3f\n", model.c_str(), walls.c_str(), courant,
-              mu, mgH, e0);
+  std::printf("# model %s walls %s courant %g mu %g  mgH %.2f E0 %.3f\n", model.c_str(), walls.c_str(),
+              courant, mu, mgH, e0);
   std::printf("# step t E-E0 KE W_pb(wall p_b term) W_shep W_hydro W_pi(wall p_i term) W_visc resid\n");
   const bool adami = cfg.wall_model != WallModel::Akinci;
   const double eps2 = 0.01 * hs * hs;
@@ -146,13 +146,14 @@ int main(int argc, char** argv) {
         double ke = 0;
         const double e = energy(&ke);
         e_max = std::max(e_max, e);
-        std::printf("%6d %.3f %9.3f %8.3f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f\n", st, sim.time(), e - e0, ke, w_pb,
-                    w_sh, w_hy, w_pi, w_visc, e - e0 - w_pb - w_visc);
+        std::printf("%6d %.3f %9.3f %8.3f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f\n", st, sim.time(), e - e0, ke,
+                    w_pb, w_sh, w_hy, w_pi, w_visc, e - e0 - w_pb - w_visc);
         std::fflush(stdout);
       }
     }
   } catch (const SimulationError& e) {
     std::printf("# blew up: %s\n", e.what());
   }
-  std::printf("# steps %llu max excess %.4f mgH\n", static_cast<unsigned long long>(sim.steps()), (e_max - e0) / mgH);
+  std::printf("# steps %llu max excess %.4f mgH\n", static_cast<unsigned long long>(sim.steps()),
+              (e_max - e0) / mgH);
 }
