@@ -28,21 +28,20 @@ int main(int argc, char** argv) {
   const double courant = argc > 3 ? std::atof(argv[3]) : 0.3;
   const int nsteps = argc > 4 ? std::atoi(argv[4]) : 10000;
   const double mu = argc > 5 ? std::atof(argv[5]) : 0.5;
-  const double s = 0.025, L = 0.5, H = 0.4, rho0 = 1000, g = 9.81;
-  const double c = 10 * std::sqrt(2 * g * L);
-  SolverConfig<2, double> cfg = test::wcsph_water(s, c);
-  cfg.model = model == "paper" ? Model::PaperMultiphase : Model::Wcsph;
-  cfg.wall_model = *parse_wall_model(walls);
-  cfg.phases[0].viscosity = mu;
+  const auto wall_model = parse_wall_model(walls);
+  if (!wall_model || (model != "wcsph" && model != "paper")) {
+    std::fprintf(stderr,
+                 "usage: cellsph_wall_energy wcsph|paper akinci|adami|dynamic [courant] [steps] [mu]\n");
+    return 2;
+  }
+  const double H = test::ViscousBox::H, rho0 = test::ViscousBox::rho0, g = test::ViscousBox::g;
+  test::ViscousBox box =
+      test::weakly_viscous_box(model == "paper" ? Model::PaperMultiphase : Model::Wcsph, *wall_model, mu);
+  SolverConfig<2, double>& cfg = box.cfg;
   cfg.time.courant = courant;
   if (const char* e = std::getenv("NOSLIP")) cfg.no_slip = std::atoi(e) != 0;
-  cfg.domain_set = true;
-  cfg.domain_lo = V2{{-0.2, -0.2}};
-  cfg.domain_hi = V2{{L + 0.2, L + 0.2}};
-  Particles<2, double> p;
-  add_block<2, double>(p, V2{{0, 0}}, V2{{L, H}}, s, 0);
-  const std::size_t fluid = p.size();
-  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 2, false, 0, rho0 * s * s);
+  Particles<2, double>& p = box.particles;
+  const std::size_t fluid = box.fluid_count;
   const std::size_t n = p.size();
   ScopedThreads one(1);
   Simulation<2, double> sim(cfg, std::move(p));

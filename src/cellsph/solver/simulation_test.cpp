@@ -61,6 +61,8 @@ SolverConfig<2, double> base_config(Model model) {
 using test::wcsph_water;
 
 using test::same_state;
+using test::ViscousBox;
+using test::weakly_viscous_box;
 
 class BothModels : public ::testing::TestWithParam<Model> {};
 
@@ -327,21 +329,13 @@ TEST_P(WallModels, HydrostaticTankSettlesToRhoGH) {
 // (WCSPH), excess 0.005 m g H and 0.008 J (paper).
 TEST_P(WallModels, WeaklyViscousBoxHoldsTenThousandSteps) {
   for (Model model : {Model::Wcsph, Model::PaperMultiphase}) {
-    const double s = 0.025, L = 0.5, H = 0.4, rho0 = 1000, g = 9.81;  // NOLINT
-    const double c = 10 * std::sqrt(2 * g * L);
-    SolverConfig<2, double> cfg = wcsph_water(s, c);
-    cfg.model = model;
-    cfg.wall_model = GetParam();
-    cfg.phases[0].viscosity = 0.5;
-    cfg.domain_set = true;
-    cfg.domain_lo = V2{{-0.2, -0.2}};
-    cfg.domain_hi = V2{{L + 0.2, L + 0.2}};
-    Particles<2, double> p;
-    add_block<2, double>(p, V2{{0, 0}}, V2{{L, H}}, s, 0);
-    const std::size_t fluid = p.size();
-    add_box_walls<2, double>(p, V2{{0, 0}}, V2{{L, L}}, s, 2, false, 0, rho0 * s * s);
+    const double s = ViscousBox::s, L = ViscousBox::L, H = ViscousBox::H, rho0 = ViscousBox::rho0,
+                 g = ViscousBox::g;
+    ViscousBox box = weakly_viscous_box(model, GetParam(), 0.5);
+    const SolverConfig<2, double>& cfg = box.cfg;
+    const std::size_t fluid = box.fluid_count;
     ScopedThreads one(1);
-    Simulation<2, double> sim(cfg, std::move(p));
+    Simulation<2, double> sim(cfg, std::move(box.particles));
     // Internal energy of the ratio EOS per unit mass: int_rho0^rho p / r^2 dr = k (ln(rho/rho0) + rho0/rho -
     // 1) / rho0, for rho > rho0 (clamped: 0 below).
     // Dynamic walls store internal energy too (their density is a summation like the fluid's): counted.

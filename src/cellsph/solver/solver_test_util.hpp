@@ -1,10 +1,13 @@
 #pragma once
 // Shared by the solver tests only.
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <string_view>
 #include <type_traits>
 
 #include "cellsph/solver/config.hpp"
+#include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/particles.hpp"
 
 namespace cellsph::test {
@@ -46,6 +49,35 @@ inline SolverConfig<2, double> wcsph_water(double s, double c) {
   cfg.time.mode = TimeStepping::Courant;
   cfg.time.dt_max = 1e-3;
   return cfg;
+}
+
+// The weakly viscous box (issue 3's wall-energy problem; WallModels.WeaklyViscousBoxHoldsTenThousandSteps and
+// tools/wall_energy_bookkeeping.cpp): water of viscosity mu filling a closed 0.5 m box of two layers of
+// volume-weighted wall particles to 0.4 m, spacing 0.025 m, wcsph_water with c = 10 sqrt(2 g L). The fluid
+// particles come first (fluid_count of them).
+struct ViscousBox {
+  static constexpr double s = 0.025, L = 0.5, H = 0.4, rho0 = 1000, g = 9.81;
+  SolverConfig<2, double> cfg;
+  Particles<2, double> particles;
+  std::size_t fluid_count = 0;
+};
+
+inline ViscousBox weakly_viscous_box(Model model, WallModel walls, double mu) {
+  using V2 = Vec<2, double>;
+  using B = ViscousBox;
+  ViscousBox box;
+  box.cfg = wcsph_water(B::s, 10 * std::sqrt(2 * B::g * B::L));
+  box.cfg.model = model;
+  box.cfg.wall_model = walls;
+  box.cfg.phases[0].viscosity = mu;
+  box.cfg.domain_set = true;
+  box.cfg.domain_lo = V2{{-0.2, -0.2}};
+  box.cfg.domain_hi = V2{{B::L + 0.2, B::L + 0.2}};
+  add_block<2, double>(box.particles, V2{{0, 0}}, V2{{B::L, B::H}}, B::s, 0);
+  box.fluid_count = box.particles.size();
+  add_box_walls<2, double>(box.particles, V2{{0, 0}}, V2{{B::L, B::L}}, B::s, 2, false, 0,
+                           B::rho0 * B::s * B::s);
+  return box;
 }
 
 }  // namespace cellsph::test
