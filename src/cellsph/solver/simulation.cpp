@@ -135,7 +135,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
     }
   }
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
-  adami_walls_ = cfg_.wall_model != WallModel::Akinci && fluid_count_ < n;
+  wall_states_ = cfg_.wall_model != WallModel::Akinci && fluid_count_ < n;
   f_pressure_.assign(n, V{});
   fluid_.clear();
   fluid_.reserve(fluid_count_);
@@ -504,7 +504,7 @@ void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const Ind
           // walls), i's pressure extrapolated to it (see mirrored_boundary_pressure) and i's colour (walls
           // are neutral to interface tension). No slip: eq. 8b against a particle at rest with i's mu.
           in.mj = p_.m[j];
-          if (adami_walls_) {
+          if (wall_states_) {
             // Adami: eq. 8a and 8b as between two fluid particles, with the wall's own pressure and
             // volume psi_b / rho_w (compute_wall_states) and its extrapolated velocity; i's mu.
             const Real vv = -vol_i * vol_[j];
@@ -571,7 +571,7 @@ void Simulation<Dim, Real>::compute_forces_wcsph() {
           fnp += g * (visc_c * (in.mui + p_.mu[j]) / 2 * vol_i * vol_[j] * q);
           fp += g * (-in.mi * p_.m[j] * (prho2_i + prho2_[j]));
           if (any_tension_) accumulate_color(cf, in.xij, in.r, vol_[j], Real(1), wc);
-        } else if (adami_walls_) {
+        } else if (wall_states_) {
           // Adami: the fluid pair terms with the wall's pressure, density and extrapolated velocity
           // (compute_wall_states); the viscosity takes i's mu.
           const V g = wg.gradW(in.xij);
@@ -904,7 +904,7 @@ void Simulation<Dim, Real>::step() {
   sw.reset();
   filter_lists(fluid_);
   compute_density_pressure(fluid_);
-  if (adami_walls_) compute_wall_states();
+  if (wall_states_) compute_wall_states();
   if (cfg_.model == Model::PaperMultiphase)
     compute_forces_paper(fluid_, fluid_);
   else

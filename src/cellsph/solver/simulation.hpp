@@ -193,7 +193,7 @@ class Simulation {
   bool any_tension_ = false;
   // WallModel::Adami or Dynamic and there are boundary particles: walls carry their own p, rho (and
   // velocity for no slip), computed each step by compute_wall_states.
-  bool adami_walls_ = false;
+  bool wall_states_ = false;
   std::size_t fluid_count_ = 0;
 
   // Integrator state (integrator_state(), restore()).
