@@ -194,6 +194,49 @@ TEST(CliRun, BadSceneExitsWithCode2NamingFileAndKey) {
   EXPECT_EQ(r3.code, 2);
 }
 
+TEST(CliRun, SetEditsTheSceneAndIsSavedForResume) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  // The tiny scene at half its spacing: 4x the fluid particles, a different run.
+  auto r =
+      run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "fine") +
+                       " --quiet --format csv --until 0.04 --set /spacing=0.025 --set /solver/support=0.05");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "coarse") +
+                       " --quiet --format csv --until 0.04");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto fluid_rows = [](const std::string& csv) {
+    std::size_t n = 0;
+    const auto rows = lines(csv);
+    const auto head = split(rows.at(0), ',');
+    std::size_t kind = 0;
+    while (kind < head.size() && head[kind] != "kind") ++kind;
+    for (std::size_t k = 1; k < rows.size(); ++k) n += split(rows[k], ',').at(kind) == "0" ? 1 : 0;
+    return n;
+  };
+  const auto coarse = fluid_rows(read_file(dir / "coarse" / "frame_00000.csv"));
+  ASSERT_GT(coarse, 0u);
+  EXPECT_EQ(fluid_rows(read_file(dir / "fine" / "frame_00000.csv")), 4 * coarse);
+  // The edited scene is what run.json keeps, so a resume continues the edited run.
+  EXPECT_NE(read_file(dir / "fine" / "run.json").find("0.025"), std::string::npos);
+  r = run_cli(dir, "run --resume " + q(dir / "fine") + " --until 0.06 --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(fluid_rows(read_file(dir / "fine" / "frame_00003.csv")), 4 * coarse);
+  r = run_cli(dir, "run --resume " + q(dir / "fine") + " --until 0.08 --set /spacing=0.05");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--set"), std::string::npos) << r.err;
+  // Bad edits exit with code 2 before anything is written, naming the edit or the key path.
+  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "bad") + " --set spacing=1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("spacing=1"), std::string::npos) << r.err;
+  r = run_cli(dir,
+              "run " + q(dir / "tiny.json") + " --out " + q(dir / "bad") + " --set /solver/eos/kind=taitt");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("/solver/eos/kind"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("taitt"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "bad" / "frames.csv"));
+}
+
 TEST(CliRun, UnstableRunStopsWithDiagnosisAndCode3) {
   TempDir dir;
   std::string s = kTiny;
@@ -244,7 +287,7 @@ TEST(CliRun, HelpDocumentsEveryOption) {
   EXPECT_EQ(r.code, 0);
   for (const char* opt :
        {"--out", "--threads", "--method", "--until", "--steps", "--fps", "--format", "--render", "--color-by",
-        "--surface", "--surface-format", "--quiet", "--resume", "default"})
+        "--surface", "--surface-format", "--quiet", "--resume", "--set", "default"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt << " missing from --help:\n" << r.out;
 }
 

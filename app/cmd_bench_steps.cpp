@@ -195,23 +195,12 @@ void add_bench_steps(CLI::App& bench, int& result) {
       ->capture_default_str();
   c->add_option("--threads", a->threads, "threads")->capture_default_str();
   c->add_option("--set", a->sets,
-                "edit the scene: /json/pointer=value (value in JSON), e.g. /phases/0/viscosity=1");
+                "edit the scene: /json/pointer=value (a JSON value, else a string), e.g. "
+                "/phases/0/viscosity=1; repeatable");
   c->callback([a, &result] {
     std::string source;
     auto j = read_scene_json(a->scene, source);
-    for (const auto& e : a->sets) {
-      const auto eq = e.find('=');
-      if (eq == std::string::npos || e.empty() || e[0] != '/')
-        throw InputError("--set '" + e + "': expected /json/pointer=value");
-      nlohmann::json value;
-      try {
-        value = nlohmann::json::parse(e.substr(eq + 1));
-        j[nlohmann::json::json_pointer(e.substr(0, eq))] = value;
-      } catch (const nlohmann::json::exception& ex) {
-        throw InputError("--set '" + e + "': " + ex.what());
-      }
-    }
-    if (!a->sets.empty()) source += " (edited)";
+    apply_scene_edits(j, a->sets, source);
     const SceneHeader h = read_scene_header(j, source);
     if (h.dim == 2) {
       if (h.single_precision)

@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -56,6 +57,7 @@ struct RunOptions {
   std::string surface_format = "ply";
   bool quiet = false;
   std::string resume;
+  std::vector<std::string> sets;  // --set /json/pointer=value edits of the scene
 };
 
 // The state of the run loop that a checkpoint stores besides the simulation.
@@ -267,9 +269,13 @@ int run_command(RunOptions opt) {
       throw InputError(run_file.string() + ": damaged (" + e.what() + ")");
     }
     resuming = true;
+    if (!opt.sets.empty())
+      throw InputError("--set: not with --resume (a resumed run keeps the scene saved in " +
+                       run_file.string() + ")");
   } else {
     if (opt.scene.empty()) opt.scene = kDefaultScene;
     scene_json = read_scene_json(opt.scene, source);
+    apply_scene_edits(scene_json, opt.sets, source);
   }
   const SceneHeader header = read_scene_header(scene_json, source);
   if (out.empty())
@@ -332,6 +338,9 @@ void register_run(CLI::App& app, int& result) {
   sub->add_option("--surface-format", opt->surface_format, "Surface mesh format: ply or obj (default: ply)");
   sub->add_flag("--quiet", opt->quiet, "No progress line and no summary");
   sub->add_option("--resume", opt->resume, "Continue the run in this output folder from its last checkpoint");
+  sub->add_option("--set", opt->sets,
+                  "Edit the scene before the run: /json/pointer=value (a JSON value, else a string), e.g. "
+                  "--set /spacing=0.01 --set /boundary/model=akinci; repeatable; saved in run.json");
   sub->callback([opt, &result] { result = run_command(*opt); });
 
   auto* scenes = app.add_subcommand("scenes", "List the built-in scenes");

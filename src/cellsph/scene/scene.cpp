@@ -33,6 +33,27 @@ nlohmann::json read_scene_json(const std::string& name_or_path, std::string& sou
   return JsonReader::parse_file(p);
 }
 
+void apply_scene_edits(nlohmann::json& j, const std::vector<std::string>& edits, std::string& source) {
+  if (edits.empty()) return;
+  std::string list;
+  for (const auto& e : edits) {
+    const auto eq = e.find('=');
+    if (eq == std::string::npos || eq == 1 || e[0] != '/')
+      throw InputError("--set '" + e + "': expected /json/pointer=value, e.g. /phases/0/viscosity=1");
+    const std::string text = e.substr(eq + 1);
+    if (text.empty()) throw InputError("--set '" + e + "': no value after '='");
+    nlohmann::json value = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (value.is_discarded()) value = text;
+    try {
+      j[nlohmann::json::json_pointer(e.substr(0, eq))] = std::move(value);
+    } catch (const nlohmann::json::exception& ex) {
+      throw InputError("--set '" + e + "': " + ex.what());
+    }
+    list += (list.empty() ? "" : " ") + e;
+  }
+  source += " (edited: " + list + ")";
+}
+
 SceneHeader read_scene_header(const nlohmann::json& j, const std::string& source) {
   if (!j.is_object())
     throw InputError(source + ": /: a scene must be a JSON object, got " + json_value_text(j));

@@ -49,6 +49,14 @@ struct Scene {
 // receives a label for error messages.
 nlohmann::json read_scene_json(const std::string& name_or_path, std::string& source);
 
+// Edits a scene's JSON before it is read, as `--set` does on the command line. Each edit is
+// "/json/pointer=value": the value (JSON; anything that does not parse as JSON is taken as a string,
+// so `/boundary/model=adami` works unquoted) replaces or adds the one at the pointer (RFC 6901,
+// e.g. /phases/0/viscosity). A malformed edit throws InputError naming it. `source` gains " (edited: ...)"
+// so later messages say that the scene is not the file's. Keys are not checked here: the strict
+// reader of load_scene rejects a misspelt one, naming its path.
+void apply_scene_edits(nlohmann::json& j, const std::vector<std::string>& edits, std::string& source);
+
 SceneHeader read_scene_header(const nlohmann::json& j, const std::string& source);
 
 template <int Dim, class Real>

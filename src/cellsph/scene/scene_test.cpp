@@ -156,5 +156,43 @@ TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
   std::filesystem::remove(path);
 }
 
+// --set edits: numbers, arrays and bare words land at their pointer; the edited scene loads.
+TEST(Scene, EditsSetValuesAtTheirPointers) {
+  auto j = nlohmann::json::parse(kMinimal);
+  std::string src = "scene.json";
+  apply_scene_edits(j, {"/spacing=0.05", "/boundary/box/max=[3, 2]", "/name=edited", "/time/end=0.5"}, src);
+  EXPECT_EQ(j["spacing"], 0.05);
+  EXPECT_EQ(j["boundary"]["box"]["max"], nlohmann::json::parse("[3, 2]"));
+  EXPECT_EQ(j["name"], "edited") << "a value that is not JSON is taken as a string";
+  EXPECT_EQ(j["time"]["end"], 0.5) << "missing objects on the way are created";
+  EXPECT_NE(src.find("scene.json (edited: /spacing=0.05"), std::string::npos) << src;
+  EXPECT_EQ(load_error(j), "");
+  const auto scene = load_scene<2, double>(j, src);
+  // 1 m x 0.5 m at 0.05 m: 20 x 10 fluid particles (50 at the file's 0.1 m).
+  std::size_t fluid = 0;
+  for (std::size_t i = 0; i < scene.particles.size(); ++i)
+    fluid += scene.particles.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) ? 1 : 0;
+  EXPECT_EQ(fluid, 200u);
+}
+
+TEST(Scene, BadEditsNameTheEdit) {
+  for (const std::string e : {"spacing=0.1", "/spacing", "/=1", "/spacing=", "/fluids/x/min=1"}) {
+    auto j = nlohmann::json::parse(kMinimal);
+    std::string src = "scene.json";
+    try {
+      apply_scene_edits(j, {e}, src);
+      FAIL() << "accepted '" << e << "'";
+    } catch (const InputError& ex) {
+      EXPECT_NE(std::string(ex.what()).find("--set '" + e + "'"), std::string::npos) << ex.what();
+    }
+  }
+  // A misspelt key is accepted by the edit and rejected by the strict reader, with its path.
+  auto j = nlohmann::json::parse(kMinimal);
+  std::string src = "scene.json";
+  apply_scene_edits(j, {"/spacng=0.05"}, src);
+  const std::string err = load_error(j);
+  EXPECT_NE(err.find("/spacng"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace cellsph
