@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <new>
 
 #include <CLI/CLI.hpp>
 
@@ -27,6 +28,10 @@ int main(int argc, char** argv) {
   } catch (const cellsph::SimulationError& e) {
     std::cerr << "cellsph: simulation stopped: " << e.what() << "\n";
     return 3;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "cellsph: error: out of memory: the run needs more memory than this machine has free "
+                 "(a larger spacing makes fewer particles)\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "cellsph: internal error: " << e.what() << "\n";
     return 1;

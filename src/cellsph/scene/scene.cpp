@@ -1,6 +1,9 @@
 #include "cellsph/scene/scene.hpp"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 
@@ -186,6 +189,52 @@ bool inside(const Aabb<Dim>& inner, const Aabb<Dim>& outer, double tol) {
   return true;
 }
 
+// About what one particle costs in a run: 256 bytes of fields and search structures, and 8 bytes for
+// each pair within the search radius h (1 + skin) (a 4-byte entry in the search's lists and in the
+// lists cut to h). For the 3D dam break (2.3 spacings, 51 pairs) that is 664 bytes; at 1.5e6
+// particles (1e6 fluid) it peaked at 0.96 GB resident, 640 bytes a particle.
+double bytes_per_particle(int dim, double search_radius_in_spacings) {
+  const double r = search_radius_in_spacings;
+  const double pairs = dim == 2 ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
+  return 256 + 8 * pairs;
+}
+
+// Counts the particles a scene asks for before any is made, so that a spacing too fine for this
+// machine stops with the key and the count instead of hours of allocation or std::bad_alloc. The
+// limit is what the machine's memory holds at bytes_per_particle, and never above 2^31 (indices).
+class ParticleBudget {
+ public:
+  ParticleBudget(double spacing, double bytes_per_particle) : spacing_(spacing) {
+    limit_ = double(std::size_t{1} << 31);
+    why_ = "2^31, the most particles a run can index";
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    const double memory = double(pages) * double(page);
+    if (pages > 0 && page > 0 && memory / bytes_per_particle < limit_) {
+      limit_ = memory / bytes_per_particle;
+      why_ = "what this machine's " + number(memory / double(1L << 30)) + " GiB of memory hold at about " +
+             number(bytes_per_particle) + " bytes a particle";
+    }
+  }
+
+  // Adds `count` particles made by the object at `key` of `r`; fails there if the total is too many.
+  void take(double count, const JsonReader& r, const std::string& key, const std::string& what) {
+    planned_ += count;
+    if (planned_ > limit_)
+      r.fail(key, "with " + what + " at spacing " + number(spacing_) + " m the scene has " +
+                      number(planned_) + " particles, more than " + number(limit_) + " (" + why_ +
+                      "): use a larger /spacing");
+  }
+
+ private:
+  static std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return buf;
+  }
+  double spacing_, limit_ = 0, planned_ = 0;
+  std::string why_;
+};
+
 // Number of lattice cells of `spacing` along each axis of a block.
 template <int Dim>
 std::array<long, 3> cells_of(const Aabb<Dim>& b, double spacing) {
@@ -323,6 +372,25 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   }
 
   // --- boundary -------------------------------------------------------------------------------
+  ParticleBudget budget(
+      spacing, bytes_per_particle(Dim, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing));
+  // The fluid blocks first (they are most of a scene, and are made last): counted from the JSON as it
+  // is; a malformed block counts 0 here and is reported by the strict reading below.
+  {
+    double fluid = 0;
+    if (j.contains("fluids") && j["fluids"].is_array())
+      for (const auto& b : j["fluids"]) {
+        if (!b.is_object() || !b.contains("min") || !b.contains("max")) continue;
+        const auto &lo = b["min"], &hi = b["max"];
+        if (!lo.is_array() || !hi.is_array() || lo.size() != Dim || hi.size() != Dim) continue;
+        double n = 1;
+        for (std::size_t a = 0; a < Dim; ++a)
+          if (lo[a].is_number() && hi[a].is_number())
+            n *= std::max(0.0, std::round((hi[a].get<double>() - lo[a].get<double>()) / spacing));
+        fluid += n;
+      }
+    budget.take(fluid, r, "fluids", "the fluid blocks");
+  }
   std::vector<Aabb<Dim>> solids;       // regions fluid must not overlap
   std::optional<Aabb<Dim>> container;  // region fluid must lie in
   auto& p = s.particles;
@@ -373,6 +441,14 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
       wr.finish();
       const Real weight =
           volume ? cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim)) : Real(0);
+      // At most the (n + 2 layers)^Dim lattice around the box minus its inside (an open top has fewer).
+      double outer = 1, inner = 1;
+      for (std::size_t a = 0; a < Dim; ++a) {
+        const double n = std::round((b.hi[a] - b.lo[a]) / spacing);
+        outer *= n + 2 * layers;
+        inner *= n;
+      }
+      budget.take(outer - inner, br, "walls", "the walls");
       // The open face is the top as gravity sees it (scenes with y up in 3D), not always the last axis.
       int up = Dim - 1;
       for (int a = 0; a < Dim; ++a)
@@ -390,6 +466,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
         const auto n = cells_of<Dim>(b, spacing);
         for (std::size_t a = 0; a < Dim; ++a)
           if (n[a] < 1) e.fail("max", "obstacle is thinner than one particle spacing");
+        budget.take(double(n[0]) * double(n[1]) * double(n[2]), ob, std::to_string(k), "this obstacle");
         // A solid block of static boundary particles.
         for (long kk = 0; kk < n[2]; ++kk)
           for (long jj = 0; jj < n[1]; ++jj)
@@ -448,7 +525,6 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
     const std::size_t first = p.size();
     add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
     for (std::size_t i = first; i < p.size(); ++i) p.v[i] = vel;
-    if (p.size() > (std::size_t{1} << 31)) e.fail_here("more than 2^31 particles");
   }
   if (r.choice("initial_pressure", "zero", {"zero", "hydrostatic"}) == "hydrostatic")
     start_hydrostatic(p, cfg, spacing, mass_given, blocks, block_phase);

@@ -194,5 +194,28 @@ TEST(Scene, BadEditsNameTheEdit) {
   EXPECT_NE(err.find("/spacng"), std::string::npos) << err;
 }
 
+// A spacing far too fine stops before any particle is made, naming the object that goes over and the
+// count (3e12 fluid particles: more than 2^31 on any machine), instead of allocating for hours.
+TEST(Scene, TooManyParticlesIsAnInputErrorBeforeAnyIsMade) {
+  std::string src;
+  auto j = read_scene_json("dam-break-2d", src);
+  apply_scene_edits(j, {"/spacing=1e-6", "/solver/support=2e-6"}, src);
+  try {
+    load_scene<2, double>(j, src);
+    FAIL() << "2e12 particles accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("particles, more than"), std::string::npos) << m;
+    EXPECT_NE(m.find("use a larger /spacing"), std::string::npos) << m;
+    EXPECT_NE(m.find("/fluids: with the fluid blocks at spacing 1e-06 m the scene has 2e+12 particles"),
+              std::string::npos)
+        << m;
+  }
+  // The same in 3D (2.5e11 fluid particles at 0.2 mm).
+  j = read_scene_json("dam-break-3d", src);
+  apply_scene_edits(j, {"/spacing=2e-4", "/solver/support=4e-4"}, src);
+  EXPECT_THROW((load_scene<3, float>(j, src)), InputError);
+}
+
 }  // namespace
 }  // namespace cellsph

@@ -56,8 +56,12 @@ std::size_t add_box_walls(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, con
   std::size_t added = 0;
   const int k0 = Dim == 3 ? -L : 0, k1 = Dim == 3 ? n[2] + L : 1;
   for (int k = k0; k < k1; ++k)
-    for (int j = -L; j < n[1] + L; ++j)
+    for (int j = -L; j < n[1] + L; ++j) {
+      // Inside the box along the other axes, a row is wall only in its first and last L sites: skip
+      // its inside, so the loop costs the walls' size, not the box's volume.
+      const bool row_inside = j >= 0 && j < n[1] && (Dim == 2 || (k >= 0 && k < n[2]));
       for (int i = -L; i < n[0] + L; ++i) {
+        if (row_inside && i == 0) i = n[0];
         const int idx[3] = {i, j, k};
         bool wall = false;
         for (int a = 0; a < Dim; ++a) wall = wall || idx[a] < 0 || idx[a] >= n[a];
@@ -68,6 +72,7 @@ std::size_t add_box_walls(Particles<Dim, Real>& p, const Vec<Dim, Real>& lo, con
         add_particle(p, x, phase, ParticleKind::Boundary, weight);
         ++added;
       }
+    }
   return added;
 }
 
