@@ -192,6 +192,15 @@ TEST(CliRun, BadSceneExitsWithCode2NamingFileAndKey) {
 
   const auto r3 = run_cli(dir, "run " + q(dir / "bad.json") + " --method octree");
   EXPECT_EQ(r3.code, 2);
+
+  // An output folder that cannot be made (a file is in the way) is named, with the reason.
+  write_file(dir / "afile", "x");
+  write_file(dir / "tiny.json", kTiny);
+  const auto r4 = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "afile" / "out"));
+  EXPECT_EQ(r4.code, 2) << r4.err;
+  EXPECT_NE(r4.err.find("output folder '" + (dir / "afile" / "out").string() + "': cannot be created"),
+            std::string::npos)
+      << r4.err;
 }
 
 TEST(CliRun, SetEditsTheSceneAndIsSavedForResume) {

@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -32,6 +33,14 @@
 
 namespace cellsph::app {
 namespace {
+
+// Creates an output folder (and its parents); a folder that cannot be made is the user's to fix
+// (a read-only place, a file in the way), so it is an InputError naming it and the reason.
+void make_folder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError("output folder '" + dir.string() + "': cannot be created: " + ec.message());
+}
 
 constexpr const char* kDefaultScene = "dam-break-2d";
 constexpr const char* kRunFile = "run.json";
@@ -124,7 +133,7 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   }
   if (!opt.color_by.empty()) os.color_by = opt.color_by;
 
-  std::filesystem::create_directories(out);
+  make_folder(out);
   Simulation<Dim, Real> sim(cfg, std::move(scene.particles));
   const auto& parts = sim.particles();
   auto is_fluid = [&parts](std::size_t i) {
@@ -156,13 +165,13 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   rbox.lo = scene.view_lo;
   rbox.hi = scene.view_hi;
   const auto png_dir = out / "png";
-  if (opt.render) std::filesystem::create_directories(png_dir);
+  if (opt.render) make_folder(png_dir);
   SurfaceOptions sopt;
   sopt.format = parse_surface_format(opt.surface_format);
   sopt.threads = max_threads();
   validate(sopt);
   const auto surface_dir = out / "surface";
-  if (opt.surface) std::filesystem::create_directories(surface_dir);
+  if (opt.surface) make_folder(surface_dir);
 
   Progress progress(opt.quiet);
   Stopwatch wall;
@@ -291,7 +300,7 @@ int run_command(RunOptions opt) {
 
   ScopedThreads threads(opt.threads);
   if (!resuming) {
-    std::filesystem::create_directories(out);
+    make_folder(out);
     nlohmann::json saved;
     saved["scene"] = scene_json;
     saved["source"] = source;

@@ -327,7 +327,13 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
       cfg.eos.clamp_negative = er.boolean("clamp_negative", cfg.eos.clamp_negative);
       er.finish();
     }
-    if (sr.has("gravity")) cfg.gravity = to_vec<Dim, Real>(sr.vector("gravity", Dim, {}));
+    if (sr.has("gravity")) {
+      const auto g = sr.vector("gravity", Dim, {});
+      for (double c : g)
+        if (!(std::abs(c) <= 1e9))
+          sr.fail("gravity", "component " + json_value_text(c) + " is beyond 1e9 m/s^2");
+      cfg.gravity = to_vec<Dim, Real>(g);
+    }
     cfg.tension_threshold = static_cast<Real>(sr.number("tension_threshold", 0, 0, 1e12));
     cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf", "akinci"}));
     cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));

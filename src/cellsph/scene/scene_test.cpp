@@ -127,6 +127,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"/solver/model", "\"pbf\"", "/solver/model", "pbf"},
                       BadCase{"/solver/eos/kind", "\"ideal\"", "/solver/eos/kind", "ideal"},
                       BadCase{"/solver/gravity", "[0, \"down\"]", "/solver/gravity", "down"},
+                      BadCase{"/solver/gravity", "[0, -1e300]", "/solver/gravity", "beyond 1e9"},
                       BadCase{"/neighbors/method", "\"octree\"", "/neighbors/method", "octree"},
                       BadCase{"/neighbors/subdivision", "0", "/neighbors/subdivision", "out of range"},
                       BadCase{"/neighbors/skin", "-0.1", "/neighbors/skin", "out of range"},
