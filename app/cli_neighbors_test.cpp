@@ -383,6 +383,19 @@ TEST(NeighborsCliInput, DirectoryAsInputIsUnreadable) {
   EXPECT_FALSE(fs::exists(dir / "out.csv"));
 }
 
+// Points 1e9 apart searched at radius 1e-3 need 1e12 cells along an axis, beyond the 2^32 a Cell
+// Indexing key holds: a limit the user can work around, reported like bad input (code 2).
+TEST(NeighborsCliInput, BeyondAKeysCapacityExitsTwoNamingTheLimit) {
+  TempDir dir;
+  write_file(dir / "far.csv", "x,y,z\n0,0,0\n1e9,1e9,1e9\n");
+  const auto r = run_cli(dir, "neighbors --input " + q(dir / "far.csv") +
+                                  " --radius 1e-3 --method cell-index --output " + q(dir / "o.csv"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("cells along axis 0"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "o.csv"));
+}
+
 TEST(NeighborsCliInput, CommandLineParseErrorsExitTwo) {
   TempDir dir;
   write_file(dir / "in.csv", kGood);

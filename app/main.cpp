@@ -25,12 +25,17 @@ int main(int argc, char** argv) {
   } catch (const cellsph::InputError& e) {
     std::cerr << "cellsph: error: " << e.what() << "\n";
     return 2;
+  } catch (const cellsph::CapacityError& e) {
+    // A limit of a data structure that this input goes beyond (key bits, bucket numbers): the user's
+    // to work around (another method, another radius or spacing), so reported as bad input.
+    std::cerr << "cellsph: error: " << e.what() << "\n";
+    return 2;
   } catch (const cellsph::SimulationError& e) {
     std::cerr << "cellsph: simulation stopped: " << e.what() << "\n";
     return 3;
   } catch (const std::bad_alloc&) {
-    std::cerr << "cellsph: error: out of memory: the run needs more memory than this machine has free "
-                 "(a larger spacing makes fewer particles)\n";
+    std::cerr << "cellsph: error: out of memory: this needs more memory than the machine has free (for a "
+                 "run: fewer particles through a larger spacing, or a smaller neighbors.hash_table_size)\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "cellsph: internal error: " << e.what() << "\n";

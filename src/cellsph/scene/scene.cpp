@@ -370,7 +370,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
     for (Method m : kAllMethods) methods.emplace_back(method_name(m));
     cfg.search.method = *parse_method(nr.choice("method", "cell-index", methods));
     cfg.search.subdivision = static_cast<int>(nr.integer("subdivision", 1, 1, 16));
-    cfg.search.hash_table_size = static_cast<std::size_t>(nr.integer("hash_table_size", 0, 0, 1L << 40));
+    cfg.search.hash_table_size = static_cast<std::size_t>(nr.integer("hash_table_size", 0, 0, 4294967294L));
     cfg.verlet_skin = static_cast<Real>(nr.number("skin", double(cfg.verlet_skin), 0, 1));
     cfg.reorder_every = static_cast<std::uint32_t>(
         nr.integer("reorder_every", static_cast<long>(cfg.reorder_every), 0, 1000000));
