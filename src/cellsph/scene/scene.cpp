@@ -193,9 +193,11 @@ bool inside(const Aabb<Dim>& inner, const Aabb<Dim>& outer, double tol) {
 // each pair within the search radius h (1 + skin) (a 4-byte entry in the search's lists and in the
 // lists cut to h). For the 3D dam break (2.3 spacings, 51 pairs) that is 664 bytes; at 1.5e6
 // particles (1e6 fluid) it peaked at 0.96 GB resident, 640 bytes a particle.
-double bytes_per_particle(int dim, double search_radius_in_spacings) {
+double pairs_per_particle(int dim, double search_radius_in_spacings) {
   const double r = search_radius_in_spacings;
-  const double pairs = dim == 2 ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
+  return dim == 2 ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
+}
+double bytes_per_particle(double pairs) {
   return 256 + 8 * pairs;
 }
 
@@ -204,16 +206,21 @@ double bytes_per_particle(int dim, double search_radius_in_spacings) {
 // limit is what the machine's memory holds at bytes_per_particle, and never above 2^31 (indices).
 class ParticleBudget {
  public:
-  ParticleBudget(double spacing, double bytes_per_particle) : spacing_(spacing) {
+  // `radius`: the search radius h (1 + skin) in spacings, which sets the pairs each particle keeps.
+  ParticleBudget(int dim, double spacing, double radius) : spacing_(spacing) {
     limit_ = double(std::size_t{1} << 31);
     why_ = "2^31, the most particles a run can index";
+    const double pairs = pairs_per_particle(dim, radius), bytes = bytes_per_particle(pairs);
     const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
     const double memory = double(pages) * double(page);
-    if (pages > 0 && page > 0 && memory / bytes_per_particle < limit_) {
-      limit_ = memory / bytes_per_particle;
+    if (pages > 0 && page > 0 && memory / bytes < limit_) {
+      limit_ = memory / bytes;
       why_ = "what this machine's " + number(memory / double(1L << 30)) + " GiB of memory hold at about " +
-             number(bytes_per_particle) + " bytes a particle";
+             number(bytes) + " bytes a particle, which has " + number(pairs) + " neighbours within " +
+             number(radius) + " spacings";
     }
+    // A support of many spacings makes every particle costly: name that way out too.
+    fix_ = radius > 8 ? "use a larger /spacing or a smaller /solver/support" : "use a larger /spacing";
   }
 
   // Adds `count` particles made by the object at `key` of `r`; fails there if the total is too many.
@@ -222,7 +229,7 @@ class ParticleBudget {
     if (planned_ > limit_)
       r.fail(key, "with " + what + " at spacing " + number(spacing_) + " m the scene has " +
                       number(planned_) + " particles, more than " + number(limit_) + " (" + why_ +
-                      "): use a larger /spacing");
+                      "): " + fix_);
   }
 
  private:
@@ -232,7 +239,7 @@ class ParticleBudget {
     return buf;
   }
   double spacing_, limit_ = 0, planned_ = 0;
-  std::string why_;
+  std::string why_, fix_;
 };
 
 // Number of lattice cells of `spacing` along each axis of a block.
@@ -378,8 +385,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   }
 
   // --- boundary -------------------------------------------------------------------------------
-  ParticleBudget budget(
-      spacing, bytes_per_particle(Dim, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing));
+  ParticleBudget budget(Dim, spacing, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing);
   // The fluid blocks first (they are most of a scene, and are made last): counted from the JSON as it
   // is; a malformed block counts 0 here and is reported by the strict reading below.
   {
