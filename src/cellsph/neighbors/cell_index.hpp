@@ -12,7 +12,8 @@
 // Cell coordinates are shifted by the mask radius so that home + offset never leaves its row: the
 // key of each mask cell relative to the home cell is one constant (deltas_), and targets off the
 // grid find no cell. When I + cell bits exceed 64 the keys widen to a 64-bit cell key sorted with a
-// 32-bit index payload (same order); beyond that, CapacityError.
+// 32-bit index payload (same order); an axis that would need more bits than that is cut at its
+// last cell, which stays exact (see build()).
 //
 // Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
 // a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
@@ -154,38 +155,50 @@ class CellIndex {
     const Bounds b = bounds(x, h);
     hmax_ = b.hmax;
     uniform_h_ = b.hmin == b.hmax;
-    // h' = (max h / H) * inflation (section 4.1); any positive size is exact when all h are 0.
+    // h' = (max h / H) * inflation (section 4.1); any positive size is exact when all h are 0. The
+    // size is kept in [kMinCellSize, kMaxCellSize] (hmask.hpp says why). A support whose square
+    // overflows Real makes every point its neighbour (distance2 <= inf): then one cell holds them all.
     cell_size_ = b.hmax > Real(0) ? double(b.hmax) / subdivision_ * kCellInflation : 1.0;
-    const double reach = double(b.hmax) / cell_size_;
+    cell_size_ = std::clamp(cell_size_, kMinCellSize<Real>, kMaxCellSize);
+    const bool one_cell = !std::isfinite(b.hmax * b.hmax);
+    const double reach = one_cell ? 0.0 : double(b.hmax) / cell_size_;
     mask_ = h_mask<Dim>(reach);
     const int pad = mask_radius(reach);
     for (int k = 0; k < Dim; ++k) origin_[k] = double(b.lo[k]);
 
     // Bits per axis: cell coordinates are shifted by `pad` so that every mask target (home + offset)
     // is non-negative and below 2^bits on every axis; targets off the grid then simply find no cell.
-    int cell_bits = 0;
+    // An axis spanning more cells than fit (2^32 per axis, 64 bits in all) is cut: its last cell
+    // takes every farther point (cell_key clamps). Clamping never moves two points' cells further
+    // apart, so every pair within h stays within mask reach: exact for any finite input, and only
+    // slower for such extreme spreads (one far outlier costs nothing: it is alone in its cell).
+    const auto pad2 = 2 * static_cast<std::uint64_t>(pad);
+    std::array<int, Dim> bits{};
     for (int k = 0; k < Dim; ++k) {
       const double cells = std::floor((double(b.hi[k]) - origin_[k]) / cell_size_) + 1.0;
-      if (!(cells + 2.0 * pad < 4294967296.0)) {
-        std::ostringstream os;
-        os << "cell-index: " << cells << " cells along axis " << k << " (extent "
-           << double(b.hi[k]) - origin_[k] << ", cell size " << cell_size_
-           << ") exceed the 2^32 cells per axis a key can hold";
-        throw CapacityError(os.str());
-      }
-      const auto top = static_cast<std::uint64_t>(cells) - 1 + 2 * static_cast<std::uint64_t>(pad);
+      const double most = 4294967296.0 - double(pad2);  // top = cells - 1 + 2 pad < 2^32
+      axis_cells_[k] = one_cell       ? 1
+                       : cells < most ? static_cast<std::uint64_t>(cells)
+                                      : static_cast<std::uint64_t>(most);
+      bits[k] = static_cast<int>(std::bit_width(axis_cells_[k] - 1 + pad2));
+    }
+    auto total_bits = [&] {
+      int t = 0;
+      for (int k = 0; k < Dim; ++k) t += bits[k];
+      return t;
+    };
+    while (total_bits() > 64) {
+      const int k = static_cast<int>(std::max_element(bits.begin(), bits.end()) - bits.begin());
+      --bits[k];  // top = 2^bits - 1
+      axis_cells_[k] = (std::uint64_t{1} << bits[k]) - pad2;
+    }
+    int cell_bits = 0;
+    for (int k = 0; k < Dim; ++k) {
       shift_[k] = cell_bits;
-      cell_bits += static_cast<int>(std::bit_width(top));
+      cell_bits += bits[k];
     }
     cell_bits_ = cell_bits;
     index_bits_ = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(n_)));  // 2^I > N (eq. 17)
-    if (cell_bits > 64) {
-      std::ostringstream os;
-      os << "cell-index: the grid needs " << cell_bits << " bits of cell coordinates (cell size "
-         << cell_size_
-         << "), more than a 64-bit key holds; the points are too spread out for their support length";
-      throw CapacityError(os.str());
-    }
     wide_ = force_wide_ || index_bits_ + cell_bits > 64;
 
     deltas_.resize(mask_.size());
@@ -343,8 +356,11 @@ class CellIndex {
   std::uint64_t cell_key(const Point& p, int pad) const {
     std::uint64_t key = 0;
     for (int k = 0; k < Dim; ++k) {
+      // p >= origin, so c >= 0 (+inf when the offset overflows): clamped to the axis' last cell.
       const double c = std::floor((double(p[k]) - origin_[k]) / cell_size_);
-      key |= (static_cast<std::uint64_t>(c) + static_cast<std::uint64_t>(pad)) << shift_[k];
+      const std::uint64_t last = axis_cells_[k] - 1;
+      const std::uint64_t ck = c < double(last) ? static_cast<std::uint64_t>(c) : last;
+      key |= (ck + static_cast<std::uint64_t>(pad)) << shift_[k];
     }
     return key;
   }
@@ -726,6 +742,7 @@ class CellIndex {
   double cell_size_ = 1.0;
   std::array<double, Dim> origin_{};
   std::array<int, Dim> shift_{};
+  std::array<std::uint64_t, Dim> axis_cells_{};  // cells per axis (the last one takes every farther point)
   int index_bits_ = 0;
   int cell_bits_ = 0;
   std::vector<MaskCell<Dim>> mask_;

@@ -225,21 +225,31 @@ TEST(CellIndex, PacksKeysWhenTheyFit) {
   EXPECT_LE(ci.index_bits() + ci.cell_bits(), 64);
 }
 
-TEST(CellIndex, RefusesGridsBeyondSixtyFourBits) {
-  // 2^31 cells on each of three axes: 96 bits of cell key, no layout holds it.
-  Points<3, double> x = {{{0, 0, 0}}, {{2.2e9, 2.2e9, 2.2e9}}};
-  const std::vector<double> h(2, 1.0);
+// Grids too wide for a key are cut at their last cell per axis, which stays exact. Three axes of
+// 2^31 cells (96 bits of cell key) and one axis of 2^33 cells (a coordinate beyond 32 bits), each
+// with a close pair at the far corner, which only an exact search finds.
+TEST(CellIndex, CutsGridsBeyondSixtyFourBitsExactly) {
+  const Points<3, double> x = {
+      {{0, 0, 0}}, {{2.2e9, 2.2e9, 2.2e9}}, {{2.2e9, 2.2e9, 2.2e9 - 0.5}}, {{1, 1, 1}}};
+  const std::vector<double> h(x.size(), 1.0);
   CellIndex<3, double> ci;
-  EXPECT_THROW(ci.build(x, h), CapacityError);
-  // 2^33 cells along one axis: a cell coordinate alone does not fit 32 bits.
-  Points<2, double> y = {{{0, 0}}, {{9.0e9, 0}}};
+  ci.build(x, h);
+  EXPECT_LE(ci.cell_bits(), 64);
+  NeighborList nl;
+  ci.find_all(nl);
+  const NeighborList ref = all_pairs<3, double>(x, h);
+  EXPECT_EQ(nl.offsets, ref.offsets);
+  EXPECT_EQ(nl.indices, ref.indices);
+  EXPECT_EQ(ref.pairs(), 2U);
+
+  const Points<2, double> y = {{{0, 0}}, {{9.0e9, 0}}, {{9.0e9 - 0.75, 0.25}}, {{0.5, 0}}};
+  const std::vector<double> hy(y.size(), 1.0);
   CellIndex<2, double> cj;
-  try {
-    cj.build(y, std::vector<double>(2, 1.0));
-    ADD_FAILURE() << "expected CapacityError";
-  } catch (const CapacityError& e) {
-    EXPECT_NE(std::string(e.what()).find("axis 0"), std::string::npos) << e.what();
-  }
+  cj.build(y, hy);
+  cj.find_all(nl);
+  const NeighborList refy = all_pairs<2, double>(y, hy);
+  EXPECT_EQ(nl.indices, refy.indices);
+  EXPECT_EQ(refy.pairs(), 4U);
 }
 
 TEST(CellIndex, RejectsSubdivisionBelowOne) {

@@ -20,6 +20,15 @@ namespace cellsph {
 
 // Cells are (h / H) * kCellInflation wide.
 inline constexpr double kCellInflation = 1.0 + 1.0 / 65536.0;
+
+// Cell sizes of the grid methods are kept in [kMinCellSize<Real>, kMaxCellSize]: 1 / cell stays finite
+// and non-zero, and below kMinCellSize (about 1e4 sqrt of the smallest normal Real) squared distances
+// may underflow, so that pairs farther apart than h can pass the test distance2 <= h^2; every pair
+// closer than one cell lies in the 3^Dim cells around its home cell, so such pairs stay candidates. A
+// cell larger than h / H is always exact: masks are built from the size actually used.
+template <class Real>
+inline constexpr double kMinCellSize = sizeof(Real) == 4 ? 1e-15 : 1e-150;
+inline constexpr double kMaxCellSize = 1e307;
 // A mask cell is kept when its gap to the home cell is <= h * kMaskSlack.
 inline constexpr double kMaskSlack = 1.0 + 1.0 / 1048576.0;
 

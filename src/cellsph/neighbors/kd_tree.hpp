@@ -124,6 +124,12 @@ class KdTree {
         const auto i = static_cast<std::uint32_t>(ii);
         const Point xi = x[i];
         const Real hi2 = h_[i] * h_[i];
+        if (!std::isfinite(hi2)) {  // h^2 overflows: every point passes distance2 <= inf
+          for (std::uint32_t j = 0; j < x.size(); ++j)
+            if (j != i) f(i, j, distance2(xi, x[j]));
+          tests += x.size() - 1;
+          continue;
+        }
         // Enlarged radius; nextafter keeps it positive when h_i = 0 so duplicates are still found.
         const Real query = std::nextafter(static_cast<Real>(hi2 * static_cast<Real>(1.0 + kRadiusSlack)),
                                           std::numeric_limits<Real>::infinity());

@@ -398,6 +398,81 @@ TEST_P(CrossMethod, NeighboursInTheFarthestMaskCells) {
   for_all_types([&]<int Dim, class Real>() { expect_exact_at_mask_edges<Dim, Real>(GetParam()); });
 }
 
+// Exact on every finite input (issue: one far outlier, 2^31-wide ranges, tiny and huge supports).
+// A cluster with outliers 10^12 away along every axis and a close pair out there: a dense grid would
+// need 10^39 cells, a key 3 x 40 bits; the methods wrap or cut their grids instead of refusing.
+TEST_P(CrossMethod, FarOutliersOfACluster) {
+  for_all_types([&]<int Dim, class Real>() {
+    auto x = point_sets::clustered<Dim, Real>(600, Real(1), 4, 21);
+    for (int k = 0; k < Dim; ++k) {
+      Vec<Dim, Real> far{};
+      far[k] = Real(1e12);
+      x.push_back(far);
+      far[(k + 1) % Dim] = Real(0.25);  // 0.25 from the outlier before: a pair far from the rest
+      x.push_back(far);
+    }
+    Vec<Dim, Real> neg{};
+    neg[0] = Real(-1e12);
+    x.push_back(neg);
+    expect_exact<Dim, Real>(GetParam(), x, Real(0.5));
+  });
+}
+
+// Coordinates spread over [0, 2^31] (2^31 cells of size 1 per axis) plus a jittered block at the top
+// corner, where float coordinates are 128 apart and collapse into duplicates.
+TEST_P(CrossMethod, CoordinateRangeOf2To31) {
+  for_all_types([&]<int Dim, class Real>() {
+    auto x = point_sets::uniform_random<Dim, Real>(400, Real(2147483648.0), 23);
+    const auto block = shifted_lattice<Dim, Real>(300, 0.5, 0.2, 2147483000.0);
+    x.insert(x.end(), block.begin(), block.end());
+    expect_exact<Dim, Real>(GetParam(), x, Real(1));
+  });
+}
+
+// Supports so small that squared distances lose precision or underflow to 0 (then every pair closer
+// than about sqrt(denorm_min) passes distance2 <= h^2, and must be found), and supports whose square
+// overflows (distance2 <= inf: every point is a neighbour).
+TEST_P(CrossMethod, TinyAndHugeSupports) {
+  for_all_types([&]<int Dim, class Real>() {
+    const double tiny[] = {1e-30, sizeof(Real) == 4 ? 1e-24 : 1e-170, sizeof(Real) == 4 ? 1e-44 : 1e-300};
+    for (double s : tiny) {
+      SCOPED_TRACE("spacing 10^" + std::to_string(std::lround(std::log10(s))));
+      const auto base = lattice<Dim, double>(300, 1, 0.3, 31);
+      Points<Dim, Real> x(base.size());
+      for (std::size_t i = 0; i < base.size(); ++i)
+        for (int k = 0; k < Dim; ++k) x[i][k] = static_cast<Real>(base[i][k] * s);
+      expect_exact<Dim, Real>(GetParam(), x, static_cast<Real>(1.5 * s));
+    }
+    // h^2 overflows: 1e20 in float, 1e160 in double; mixed with ordinary supports, and points far
+    // beyond h (1e30, 1e200) that are its neighbours all the same.
+    auto x = lattice<Dim, Real>(300, 1, 0.3, 32);
+    for (double far : {sizeof(Real) == 4 ? 1e30 : 1e200, sizeof(Real) == 4 ? -3e38 : -1e300}) {
+      Vec<Dim, Real> p{};
+      p[Dim - 1] = static_cast<Real>(far);
+      x.push_back(p);
+    }
+    std::vector<Real> h(x.size(), Real(1.5));
+    h[7] = static_cast<Real>(sizeof(Real) == 4 ? 1e20 : 1e160);
+    expect_exact<Dim, Real>(GetParam(), x, h);
+  });
+}
+
+// Coordinates near the largest finite values: differences overflow to inf (never a neighbour).
+TEST_P(CrossMethod, CoordinatesNearTheLargestFinite) {
+  for_all_types([&]<int Dim, class Real>() {
+    const double big = sizeof(Real) == 4 ? 3e38 : 1e308;
+    auto x = lattice<Dim, Real>(200, 1, 0.3, 33);
+    for (double sgn : {1.0, -1.0})
+      for (double d : {0.0, 0.5}) {
+        Vec<Dim, Real> p{};
+        p[0] = static_cast<Real>(sgn * big);
+        p[Dim - 1] = static_cast<Real>(d);
+        x.push_back(p);
+      }
+    expect_exact<Dim, Real>(GetParam(), x, Real(1));
+  });
+}
+
 INSTANTIATE_TEST_SUITE_P(Methods, CrossMethod, ::testing::ValuesIn(all_params()), param_test_name);
 
 // Spatial Hashing with tiny tables: many cells per bucket and mask cells hashing to one bucket.
@@ -427,17 +502,19 @@ TEST(SpatialHash, DefaultTableSizeIsPrimeAtLeastTwiceN) {
   EXPECT_EQ(sh.table_size(), 23U);
 }
 
-TEST(SortedGrid, RefusesADenseGridTooLargeForMemory) {
-  const std::vector<Vec<3, double>> x = {{{0.0, 0.0, 0.0}}, {{1e4, 1e4, 1e4}}};
-  const std::vector<double> h(2, 1e-2);
-  NeighborSearch<3, double> ns({.method = Method::SortedGrid});
-  try {
-    ns.build(x, h);
-    FAIL() << "expected CapacityError";
-  } catch (const CapacityError& e) {
-    EXPECT_NE(std::string(e.what()).find("cells"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("bytes"), std::string::npos) << e.what();
-  }
+// A dense grid over this box would have 10^18 cells: the grid wraps, stays small and exact.
+TEST(SortedGrid, WrapsADenseGridTooLargeForMemory) {
+  std::vector<Vec<3, double>> x = {{{0.0, 0.0, 0.0}}, {{1e4, 1e4, 1e4}}, {{1e4, 1e4, 1e4 + 5e-3}}};
+  for (int i = 0; i < 200; ++i)  // a small cluster that shares slots with far cells
+    x.push_back({{1e-3 * (i % 7), 1e-3 * (i / 7 % 5), 1e-3 * (i / 35)}});
+  const std::vector<double> h(x.size(), 1e-2);
+  SortedGrid<3, double> sg;
+  sg.build(x, h);
+  EXPECT_TRUE(sg.wrapped());
+  EXPECT_LT(sg.memory_bytes(), std::size_t{64} << 20);
+  NeighborList nl;
+  build_csr(sg, x.size(), nl);
+  EXPECT_TRUE(same_lists(brute_force(x, h), nl));
 }
 
 }  // namespace

@@ -5,14 +5,20 @@
 // whole dense grid give each cell's range of sorted particles. A query scans the H-mask cells
 // around the particle's own cell (3^Dim cells for H = 1).
 //
-// The dense arrays cost 8 bytes per grid cell whether occupied or not; a sparse set in a large box
-// can need far more memory than the particles themselves, so the cell count is capped.
+// The dense arrays cost 8 bytes per grid cell whether occupied or not, so a sparse set in a large box
+// (one far outlier, say) would need far more memory than the particles themselves. Past
+// max(2^22, 8 n) cells the grid wraps, as the CUDA sample's fixed-size grid does: cell c goes to slot
+// (c_k mod w_k) per axis, with every w_k at least the mask's width 2R + 1. Distant cells then share a
+// slot and their particles are rejected by the distance test; exactness holds because two cells of one
+// mask never share a slot, and a particle in a shared slot that lies within h of the query would have
+// its cell within R of the home cell on every axis, hence be in the slot's own cell.
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <span>
-#include <sstream>
 #include <vector>
 
 #include "cellsph/core/error.hpp"
@@ -29,8 +35,8 @@ class SortedGrid {
   using Point = Vec<Dim, Real>;
   using Cell = typename CellFrame<Dim, Real>::Cell;
 
-  // Largest dense grid accepted: 2^27 cells, i.e. 1 GiB of cellStart/cellEnd.
-  static constexpr double kMaxCells = 134217728.0;
+  // Dense grids up to max(2^22 cells (32 MiB of cellStart/cellEnd), 8 n); larger ones wrap.
+  static constexpr double kDenseCells = 4194304.0;
 
   explicit SortedGrid(const SearchOptions& opt = {}) : subdivision_(opt.subdivision) {}
 
@@ -38,19 +44,26 @@ class SortedGrid {
     const std::size_t n = x.size();
     frame_.build(x, h, subdivision_, "sorted-grid");
     mask_ = frame_.mask();
+    int radius = 0;  // R: the mask's largest offset along any axis
+    for (const MaskCell<Dim>& m : mask_)
+      for (int k = 0; k < Dim; ++k) radius = std::max(radius, std::abs(m.offset[k]));
     double cells = 1.0;
-    for (int k = 0; k < Dim; ++k) cells *= static_cast<double>(frame_.dims[k]);
-    if (cells > kMaxCells) {
-      std::ostringstream os;
-      os << "sorted-grid: the dense grid over the bounding box would have " << cells << " cells (";
-      for (int k = 0; k < Dim; ++k) os << (k ? " x " : "") << frame_.dims[k];
-      os << ", cell size " << frame_.cell << ") needing " << cells * 2 * sizeof(std::uint32_t)
-         << " bytes for cellStart/cellEnd; the limit is " << kMaxCells
-         << " cells. Use cell-index or spatial-hash for sparse point sets.";
-      throw CapacityError(os.str());
+    for (int k = 0; k < Dim; ++k) {
+      wrap_[k] = frame_.dims[k];
+      cells *= static_cast<double>(frame_.dims[k]);
+    }
+    const double limit = std::max(kDenseCells, 8.0 * static_cast<double>(n));
+    wrapped_ = cells > limit;
+    const std::int64_t narrowest = 2 * static_cast<std::int64_t>(radius) + 1;
+    while (cells > limit) {
+      const int k = static_cast<int>(std::max_element(wrap_.begin(), wrap_.end()) - wrap_.begin());
+      if (wrap_[k] <= narrowest) break;  // (2R + 1)^Dim slots: never more than a few thousand
+      cells /= static_cast<double>(wrap_[k]);
+      wrap_[k] = std::max(wrap_[k] / 2, narrowest);
+      cells *= static_cast<double>(wrap_[k]);
     }
     const auto num_cells = static_cast<std::size_t>(cells);
-    for (int k = 0; k < Dim; ++k) stride_[k] = k == 0 ? 1 : stride_[k - 1] * frame_.dims[k - 1];
+    for (int k = 0; k < Dim; ++k) stride_[k] = k == 0 ? 1 : stride_[k - 1] * wrap_[k - 1];
 
     // calcHash: key = (linear cell index << 32) | particle index, so sorting the keys sorts the
     // (hash, index) pairs by hash with ties in index order: the same order for any thread count.
@@ -114,6 +127,11 @@ class SortedGrid {
     return tests;
   }
 
+  // True when the grid wraps (more cells than max(2^22, 8 n)): for tests and statistics.
+  [[nodiscard]] bool wrapped() const {
+    return wrapped_;
+  }
+
   [[nodiscard]] std::size_t memory_bytes() const {
     return (cell_start_.capacity() + cell_end_.capacity() + index_.capacity()) * sizeof(std::uint32_t) +
            xs_.capacity() * sizeof(Point) + hs_.capacity() * sizeof(Real) +
@@ -123,16 +141,21 @@ class SortedGrid {
  private:
   static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
 
+  // The slot of cell c: its linear index, or with a wrapped grid that of (c_k mod w_k).
   [[nodiscard]] std::uint64_t linear(const Cell& c) const {
     std::uint64_t v = 0;
-    for (int k = 0; k < Dim; ++k)
-      v += static_cast<std::uint64_t>(c[k]) * static_cast<std::uint64_t>(stride_[k]);
+    for (int k = 0; k < Dim; ++k) {
+      const std::int64_t ck = wrapped_ ? c[k] % wrap_[k] : c[k];
+      v += static_cast<std::uint64_t>(ck) * static_cast<std::uint64_t>(stride_[k]);
+    }
     return v;
   }
 
   int subdivision_;
   CellFrame<Dim, Real> frame_;
   std::array<std::int64_t, Dim> stride_{};
+  std::array<std::int64_t, Dim> wrap_{};  // slots per axis (the cells per axis unless wrapped_)
+  bool wrapped_ = false;
   std::vector<MaskCell<Dim>> mask_;
   std::vector<std::uint32_t> cell_start_, cell_end_, index_;
   std::vector<Point> xs_;

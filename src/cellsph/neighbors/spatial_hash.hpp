@@ -38,6 +38,10 @@ struct CellFrame {
   double inv_cell = 1.0;
   double max_h = 0.0;
 
+  // 2^30 cells per axis: cell coordinates plus mask offsets stay well inside int32.
+  static constexpr double kMaxCellsPerAxis = 1073741824.0;
+  bool one_cell = false;  // h^2 overflows Real: every point is in one cell (see build)
+
   // `what` names the method in error messages.
   void build(std::span<const Vec<Dim, Real>> x, std::span<const Real> h, int subdivision, const char* what) {
     CELLSPH_CHECK(subdivision >= 1, what << ": subdivision H must be >= 1, got " << subdivision);
@@ -62,16 +66,22 @@ struct CellFrame {
     for (int k = 0; k < Dim; ++k) extent = std::max(extent, hi[k] - lo[k]);
     // With every h = 0 only exact duplicates are neighbours; any positive cell size is exact then.
     cell = max_h > 0.0 ? max_h / subdivision * kCellInflation : std::max(extent, 1.0);
+    cell = std::clamp(cell, kMinCellSize<Real>, kMaxCellSize);  // see hmask.hpp
     inv_cell = 1.0 / cell;
+    // A support whose square overflows Real makes every point a neighbour (distance2 <= inf): one
+    // cell holds them all, and its own cell is the whole mask.
+    one_cell = !std::isfinite(static_cast<Real>(max_h) * static_cast<Real>(max_h));
+    if (one_cell) {
+      dims.fill(1);
+      return;
+    }
     for (int k = 0; k < Dim; ++k) {
+      // Beyond kMaxCellsPerAxis the last cell of the axis takes every farther point (cell_of clamps).
+      // Clamping never moves two points' cells further apart, so every pair within h still lies in
+      // mask reach of each other: exact for any finite input, only slower for such extreme spreads.
       const double d = std::floor((hi[k] - lo[k]) * inv_cell) + 1.0;
-      if (!(d < 1073741824.0)) {  // 2^30: cell coordinates plus mask offsets must fit int32
-        std::ostringstream os;
-        os << what << ": the bounding box spans " << d << " cells of size " << cell << " along axis " << k
-           << " (extent " << hi[k] - lo[k] << "); at most 2^30 cells per axis are supported";
-        throw CapacityError(os.str());
-      }
-      dims[k] = static_cast<std::int64_t>(d);
+      dims[k] =
+          d < kMaxCellsPerAxis ? static_cast<std::int64_t>(d) : static_cast<std::int64_t>(kMaxCellsPerAxis);
     }
   }
 
@@ -89,7 +99,9 @@ struct CellFrame {
   [[nodiscard]] double reach(Real h) const { return static_cast<double>(h) * inv_cell; }
 
   // The mask for the largest support; smaller supports skip cells per particle with mask_keeps.
-  [[nodiscard]] std::vector<MaskCell<Dim>> mask() const { return h_mask<Dim>(max_h * inv_cell); }
+  [[nodiscard]] std::vector<MaskCell<Dim>> mask() const {
+    return h_mask<Dim>(one_cell ? 0.0 : max_h * inv_cell);
+  }
 
   [[nodiscard]] bool inside(const Cell& c) const {
     for (int k = 0; k < Dim; ++k)
