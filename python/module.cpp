@@ -22,7 +22,8 @@ std::string repr_text(const py::handle& h) {
 
 int check_threads(int threads, const char* name) {
   if (threads < 0)
-    throw ArgumentError(std::string(name) + ": must be >= 1, or 0 for all cores; got " + std::to_string(threads));
+    throw ArgumentError(std::string(name) + ": must be >= 1, or 0 for all cores; got " +
+                        std::to_string(threads));
   return threads;
 }
 
@@ -34,7 +35,9 @@ std::string shape_text(const py::array& a) {
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
-std::string dtype_text(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+std::string dtype_text(const py::array& a) {
+  return py::str(a.dtype()).cast<std::string>();
+}
 
 // Any array-like as a NumPy array (a NumPy array itself is returned as it is).
 py::array as_array(const py::handle& obj, const char* name) {
@@ -73,7 +76,8 @@ py::array points_array(const py::handle& points, const char* name) {
                         ", expected float32 or float64 (convert with .astype(numpy.float64))");
   if (a.ndim() != 2 || (a.shape(1) != 2 && a.shape(1) != 3))
     throw ArgumentError(std::string(name) + ": shape " + shape_text(a) + ", expected (n, 2) or (n, 3)");
-  constexpr int kWanted = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_;
+  constexpr int kWanted =
+      py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_;
   if ((a.flags() & kWanted) != kWanted) a = py::array::ensure(a, kWanted);  // strided or unaligned: one copy
   if (f32)
     check_finite<float>(a, name);
@@ -101,8 +105,7 @@ py::array support_array(const py::handle& h, std::size_t n, bool is_float32, con
       }
     return py::array(typed);
   };
-  if (is_float32)
-    return check(py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a));
+  if (is_float32) return check(py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a));
   return check(py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a));
 }
 
@@ -140,7 +143,8 @@ PYBIND11_MODULE(_cellsph, m) {
     }
   });
 
-  m.def("max_threads", &cellsph::max_threads, "The number of threads `threads=0` uses (all cores, or OMP_NUM_THREADS).");
+  m.def("max_threads", &cellsph::max_threads,
+        "The number of threads `threads=0` uses (all cores, or OMP_NUM_THREADS).");
   register_neighbors(m);
   register_simulation(m);
 }

@@ -34,8 +34,8 @@ py::array owning_array(std::vector<U>&& v) {
 Method method_arg(const std::string& name) {
   const auto m = parse_method(name);
   if (!m)
-    throw ArgumentError("method: unknown method '" + name + "' (expected one of " + method_names_joined(", ") +
-                        ")");
+    throw ArgumentError("method: unknown method '" + name + "' (expected one of " +
+                        method_names_joined(", ") + ")");
   return *m;
 }
 
@@ -62,7 +62,8 @@ Query query_args(const py::handle& points, const std::optional<double>& radius, 
   q.f32 = py::isinstance<py::array_t<float>>(q.points);
   q.n = static_cast<std::size_t>(q.points.shape(0));
   const bool has_h = !h.is_none();
-  if (radius && has_h) throw ArgumentError("radius and h: give one, not both (radius=" + repr_text(py::float_(*radius)) + ")");
+  if (radius && has_h)
+    throw ArgumentError("radius and h: give one, not both (radius=" + repr_text(py::float_(*radius)) + ")");
   if (!radius && !has_h) throw ArgumentError("radius: required (or h, one support length per point)");
   if (radius) q.radius = check_radius(*radius);
   if (has_h) q.h = support_array(h, q.n, q.f32);
@@ -208,9 +209,8 @@ class PyNeighborSearch {
   [[nodiscard]] py::dict stats() const {
     py::dict d;
     if (!built_) return d;
-    const SearchStats s = dispatch(q_, [&]<int Dim, class Real>() {
-      return std::get<NeighborSearch<Dim, Real>>(ns_).stats();
-    });
+    const SearchStats s =
+        dispatch(q_, [&]<int Dim, class Real>() { return std::get<NeighborSearch<Dim, Real>>(ns_).stats(); });
     d["build_ms"] = s.build_ms;
     d["query_ms"] = s.query_ms;
     d["pairs"] = s.pairs;
@@ -223,13 +223,18 @@ class PyNeighborSearch {
   [[nodiscard]] int subdivision() const { return opt_.subdivision; }
   [[nodiscard]] int threads() const { return threads_; }
   [[nodiscard]] std::size_t size() const { return built_ ? q_.n : 0; }
-  [[nodiscard]] py::object dim() const { return built_ ? py::object(py::int_(q_.dim)) : py::object(py::none()); }
-  [[nodiscard]] py::object dtype() const { return built_ ? py::object(q_.points.dtype()) : py::object(py::none()); }
+  [[nodiscard]] py::object dim() const {
+    return built_ ? py::object(py::int_(q_.dim)) : py::object(py::none());
+  }
+  [[nodiscard]] py::object dtype() const {
+    return built_ ? py::object(q_.points.dtype()) : py::object(py::none());
+  }
   [[nodiscard]] py::object points() const { return built_ ? py::object(q_.points) : py::object(py::none()); }
 
  private:
   void require_built(const char* what) const {
-    if (!built_) throw py::value_error(std::string("NeighborSearch.") + what + "(): call build(points, ...) first");
+    if (!built_)
+      throw py::value_error(std::string("NeighborSearch.") + what + "(): call build(points, ...) first");
   }
 
   SearchOptions opt_;
@@ -286,13 +291,17 @@ void register_neighbors(py::module_& m) {
         "Same arguments and neighbour relation as neighbors().",
         "points"_a, "radius"_a = py::none(), "h"_a = py::none(), "method"_a = "cell-index", "threads"_a = 0,
         "subdivision"_a = 1);
-  m.def("methods", [] {
-    py::list l;
-    for (const Method me : kAllMethods) l.append(std::string(method_name(me)));
-    return l;
-  }, "The names of the neighbour-search methods.");
+  m.def(
+      "methods",
+      [] {
+        py::list l;
+        for (const Method me : kAllMethods) l.append(std::string(method_name(me)));
+        return l;
+      },
+      "The names of the neighbour-search methods.");
 
-  py::class_<PyNeighborSearch>(m, "NeighborSearch", R"doc(A reusable neighbour search, for repeated queries on moving points.
+  py::class_<PyNeighborSearch>(m, "NeighborSearch",
+                               R"doc(A reusable neighbour search, for repeated queries on moving points.
 
     ns = cellsph.NeighborSearch(method="cell-index", threads=0)
     for step in range(100):
@@ -301,10 +310,11 @@ void register_neighbors(py::module_& m) {
 
 find_all() and count() read the arrays given to the last build(): call build() again after changing them.
 One search at a time per object (calls from several Python threads wait for each other).)doc")
-      .def(py::init<const std::string&, int, int>(), "method"_a = "cell-index", "subdivision"_a = 1, "threads"_a = 0)
+      .def(py::init<const std::string&, int, int>(), "method"_a = "cell-index", "subdivision"_a = 1,
+           "threads"_a = 0)
       .def("build", &PyNeighborSearch::build,
-           "Builds the structure for points (n, 2|3) float32/float64 with one radius or per-point h.", "points"_a,
-           "radius"_a = py::none(), "h"_a = py::none())
+           "Builds the structure for points (n, 2|3) float32/float64 with one radius or per-point h.",
+           "points"_a, "radius"_a = py::none(), "h"_a = py::none())
       .def("find_all", &PyNeighborSearch::find_all,
            "(offsets int64, indices uint32[, distances]) of the last build; rows sorted ascending.",
            "return_distances"_a = false)
@@ -316,8 +326,10 @@ One search at a time per object (calls from several Python threads wait for each
       .def_property_readonly("threads", &PyNeighborSearch::threads)
       .def_property_readonly("size", &PyNeighborSearch::size, "Points of the last build (0 before).")
       .def_property_readonly("dim", &PyNeighborSearch::dim, "2 or 3 (None before the first build).")
-      .def_property_readonly("dtype", &PyNeighborSearch::dtype, "float32 or float64 (None before the first build).")
-      .def_property_readonly("points", &PyNeighborSearch::points, "The points array of the last build (read in place).");
+      .def_property_readonly("dtype", &PyNeighborSearch::dtype,
+                             "float32 or float64 (None before the first build).")
+      .def_property_readonly("points", &PyNeighborSearch::points,
+                             "The points array of the last build (read in place).");
 }
 
 }  // namespace cellsph::python

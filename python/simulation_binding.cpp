@@ -52,7 +52,8 @@ nlohmann::json to_json(const py::handle& obj, const std::string& what) {
   try {
     text = py::module_::import("json").attr("dumps")(obj, py::arg("allow_nan") = false).cast<std::string>();
   } catch (const py::error_already_set& e) {
-    throw ArgumentError(what + ": not expressible as JSON (" + std::string(e.what()) + "): " + repr_text(obj));
+    throw ArgumentError(what + ": not expressible as JSON (" + std::string(e.what()) +
+                        "): " + repr_text(obj));
   }
   return nlohmann::json::parse(text);
 }
@@ -81,15 +82,17 @@ struct PyScene {
       particles = s.particles.size();
     };
     if (header.dim == 2)
-      header.single_precision ? take(load_scene<2, float>(json, source)) : take(load_scene<2, double>(json, source));
+      header.single_precision ? take(load_scene<2, float>(json, source))
+                              : take(load_scene<2, double>(json, source));
     else
-      header.single_precision ? take(load_scene<3, float>(json, source)) : take(load_scene<3, double>(json, source));
+      header.single_precision ? take(load_scene<3, float>(json, source))
+                              : take(load_scene<3, double>(json, source));
   }
 
   static PyScene load(const py::handle& name_or_path) {
     std::string source;
     std::string arg = py::isinstance<py::str>(name_or_path) ? name_or_path.cast<std::string>()
-                                                             : path_arg(name_or_path, "name_or_path").string();
+                                                            : path_arg(name_or_path, "name_or_path").string();
     nlohmann::json j = read_scene_json(arg, source);
     return PyScene(std::move(j), std::move(source));
   }
@@ -180,9 +183,8 @@ class SimImpl final : public SimBase {
   [[nodiscard]] py::dict fields() const override {
     const auto from = id_order();
     py::dict d;
-    sim_.particles().for_each_field([&](std::string_view name, const auto& f) {
-      d[py::str(std::string(name))] = gather(f, from);
-    });
+    sim_.particles().for_each_field(
+        [&](std::string_view name, const auto& f) { d[py::str(std::string(name))] = gather(f, from); });
     return d;
   }
 
@@ -396,52 +398,66 @@ class PySimulation {
 void register_simulation(py::module_& m) {
   using namespace pybind11::literals;
 
-  py::class_<PyScene>(m, "Scene", R"doc(A scene: the JSON of docs/scenes.md, validated as `cellsph run` validates it.
+  py::class_<PyScene>(m, "Scene",
+                      R"doc(A scene: the JSON of docs/scenes.md, validated as `cellsph run` validates it.
 
     scene = cellsph.Scene.load("dam-break-2d")      # a built-in scene name or a .json path
     scene.set("/spacing", 0.04)                     # as `cellsph run --set /spacing=0.04`
     scene = cellsph.Scene.from_dict(d)              # a scene as a Python dict
 
 Every error is a ValueError with the message of the command line (file or source, key path, value).)doc")
-      .def_static("load", &PyScene::load, "A built-in scene (see scenes()) or a scene .json file.", "name_or_path"_a)
+      .def_static("load", &PyScene::load, "A built-in scene (see scenes()) or a scene .json file.",
+                  "name_or_path"_a)
       .def_static("from_dict", &PyScene::from_dict,
                   "A scene from its JSON as a dict; `source` labels it in error messages.", "scene"_a,
                   "source"_a = "Scene.from_dict")
-      .def("set", [](PyScene& s, const std::string& pointer, const py::object& value) -> PyScene& {
-             s.set(pointer, value);
-             return s;
-           },
-           py::return_value_policy::reference_internal,
-           "Sets the value at a JSON pointer (e.g. '/phases/0/viscosity'), then validates the scene; on error "
-           "(ValueError) the scene is unchanged. Returns the scene.",
-           "pointer"_a, "value"_a)
-      .def("to_dict", [](const PyScene& s) { return to_python(s.json); }, "The scene's JSON as a new dict.")
+      .def(
+          "set",
+          [](PyScene& s, const std::string& pointer, const py::object& value) -> PyScene& {
+            s.set(pointer, value);
+            return s;
+          },
+          py::return_value_policy::reference_internal,
+          "Sets the value at a JSON pointer (e.g. '/phases/0/viscosity'), then validates the scene; on error "
+          "(ValueError) the scene is unchanged. Returns the scene.",
+          "pointer"_a, "value"_a)
+      .def(
+          "to_dict", [](const PyScene& s) { return to_python(s.json); }, "The scene's JSON as a new dict.")
       .def_property_readonly("name", [](const PyScene& s) { return s.header.name; })
       .def_property_readonly("description", [](const PyScene& s) { return s.header.description; })
       .def_property_readonly("dim", [](const PyScene& s) { return s.header.dim; })
       .def_property_readonly("precision", &PyScene::precision, "'float' or 'double'.")
-      .def_property_readonly("source", [](const PyScene& s) { return s.source; },
-                             "Where the scene came from (file, built-in name, edits), as messages name it.")
-      .def_property_readonly("end_time", [](const PyScene& s) { return s.output.end_time; }, "time.end [s].")
-      .def_property_readonly("fps", [](const PyScene& s) { return s.output.fps; }, "output.fps.")
-      .def_property_readonly("formats", [](const PyScene& s) { return s.output.formats; }, "output.formats.")
-      .def_property_readonly("particle_count", [](const PyScene& s) { return s.particles; },
-                             "Particles (fluid and boundary) the scene makes.")
+      .def_property_readonly(
+          "source", [](const PyScene& s) { return s.source; },
+          "Where the scene came from (file, built-in name, edits), as messages name it.")
+      .def_property_readonly(
+          "end_time", [](const PyScene& s) { return s.output.end_time; }, "time.end [s].")
+      .def_property_readonly(
+          "fps", [](const PyScene& s) { return s.output.fps; }, "output.fps.")
+      .def_property_readonly(
+          "formats", [](const PyScene& s) { return s.output.formats; }, "output.formats.")
+      .def_property_readonly(
+          "particle_count", [](const PyScene& s) { return s.particles; },
+          "Particles (fluid and boundary) the scene makes.")
       .def("__repr__", [](const PyScene& s) {
-        return "<cellsph.Scene '" + s.header.name + "': " + std::to_string(s.header.dim) + "D " + s.precision() +
-               ", " + std::to_string(s.particles) + " particles, from " + s.source + ">";
+        return "<cellsph.Scene '" + s.header.name + "': " + std::to_string(s.header.dim) + "D " +
+               s.precision() + ", " + std::to_string(s.particles) + " particles, from " + s.source + ">";
       });
 
-  m.def("scenes", [] {
-    py::list l;
-    for (const auto& s : builtin_scenes()) l.append(std::string(s.name));
-    return l;
-  }, "The names of the built-in scenes.");
+  m.def(
+      "scenes",
+      [] {
+        py::list l;
+        for (const auto& s : builtin_scenes()) l.append(std::string(s.name));
+        return l;
+      },
+      "The names of the built-in scenes.");
 
   auto field_prop = [](const char* name) {
     return [name](const PySimulation& s) { return s.locked([&](SimBase& b) { return b.field(name); }); };
   };
-  py::class_<PySimulation>(m, "Simulation", R"doc(A running simulation of a Scene (the solver of `cellsph run`).
+  py::class_<PySimulation>(m, "Simulation",
+                           R"doc(A running simulation of a Scene (the solver of `cellsph run`).
 
     sim = cellsph.Simulation(scene, threads=2)
     sim.run_until(0.5)                  # steps as `cellsph run --until 0.5`
@@ -450,51 +466,68 @@ Every error is a ValueError with the message of the command line (file or source
 The same scene and thread count give the same bits as `cellsph run`. Particle fields are copies in id order
 (row k is the particle with id k, for every field and every call), fluid and boundary particles together
 (`kind`: 0 fluid, 1 boundary). The GIL is released while the solver steps.)doc")
-      .def(py::init<const PyScene&, int, const std::string&>(), "scene"_a, "threads"_a = 0, "backend"_a = "cpu",
+      .def(py::init<const PyScene&, int, const std::string&>(), "scene"_a, "threads"_a = 0,
+           "backend"_a = "cpu",
            "threads: OpenMP threads for every call (0 = all cores). backend: 'cpu' (a build without the GPU "
            "backend raises RuntimeError for 'cuda').")
-      .def_static("resume", &PySimulation::resume, "A simulation from a file written by checkpoint().", "path"_a,
-                  "threads"_a = 0, "backend"_a = "cpu")
+      .def_static("resume", &PySimulation::resume, "A simulation from a file written by checkpoint().",
+                  "path"_a, "threads"_a = 0, "backend"_a = "cpu")
       .def("step", &PySimulation::step, "Advances `count` time steps.", "count"_a = 1)
-      .def("run_until", [](py::object self, double t, const py::object& callback) {
-             self.cast<PySimulation&>().run_until(self, t, callback);
-           },
-           "Steps until time >= t (the last step is not shortened), as `cellsph run --until t`. callback(sim) "
-           "runs after every step; returning False stops early.",
-           "t"_a, "callback"_a = py::none())
+      .def(
+          "run_until",
+          [](py::object self, double t, const py::object& callback) {
+            self.cast<PySimulation&>().run_until(self, t, callback);
+          },
+          "Steps until time >= t (the last step is not shortened), as `cellsph run --until t`. callback(sim) "
+          "runs after every step; returning False stops early.",
+          "t"_a, "callback"_a = py::none())
       .def("write_frame", &PySimulation::write_frame,
-           "Writes the current state as the next frame of folder `dir` (frame_NNNNN.vtu/.ply/.csv, frames.csv, "
+           "Writes the current state as the next frame of folder `dir` (frame_NNNNN.vtu/.ply/.csv, "
+           "frames.csv, "
            "particles.pvd; created if needed; numbering continues a frames.csv already there). formats: "
            "'vtu,csv', a list, or None for the scene's output.formats. Returns the files written.",
            "dir"_a, "formats"_a = py::none())
       .def("checkpoint", &PySimulation::checkpoint,
            "Writes the whole state (every particle field, the integrator state and the scene) to `path`, "
-           "atomically; Simulation.resume(path) continues bit for bit.", "path"_a)
-      .def_property_readonly("time", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.time(); }); },
-                             "Simulated time [s].")
-      .def_property_readonly("steps", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.steps(); }); },
-                             "Steps taken.")
-      .def_property_readonly("dt", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.last_dt(); }); },
-                             "The last step's dt [s].")
+           "atomically; Simulation.resume(path) continues bit for bit.",
+           "path"_a)
+      .def_property_readonly(
+          "time", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.time(); }); },
+          "Simulated time [s].")
+      .def_property_readonly(
+          "steps", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.steps(); }); },
+          "Steps taken.")
+      .def_property_readonly(
+          "dt", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.last_dt(); }); },
+          "The last step's dt [s].")
       .def_property_readonly("threads", [](const PySimulation& s) { return s.impl().threads(); })
-      .def_property_readonly("scene", [](const PySimulation& s) { return s.impl().scene(); }, "A copy of the scene.")
+      .def_property_readonly(
+          "scene", [](const PySimulation& s) { return s.impl().scene(); }, "A copy of the scene.")
       .def_property_readonly("dim", [](const PySimulation& s) { return s.impl().scene().header.dim; })
-      .def_property_readonly("size", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.size(); }); },
-                             "Particles, fluid and boundary.")
-      .def_property_readonly("fluid_count", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fluid_count(); }); })
+      .def_property_readonly(
+          "size", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.size(); }); },
+          "Particles, fluid and boundary.")
+      .def_property_readonly(
+          "fluid_count",
+          [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fluid_count(); }); })
       .def_property_readonly("positions", field_prop("position"), "(n, dim) positions [m], copy in id order.")
-      .def_property_readonly("velocities", field_prop("velocity"),
-                             "(n, dim) velocities [m/s], copy in id order (the paper model holds v(t - dt/2)).")
+      .def_property_readonly(
+          "velocities", field_prop("velocity"),
+          "(n, dim) velocities [m/s], copy in id order (the paper model holds v(t - dt/2)).")
       .def_property_readonly("density", field_prop("density"), "(n,) density [kg/m^3], copy in id order.")
       .def_property_readonly("pressure", field_prop("pressure"), "(n,) pressure [Pa], copy in id order.")
       .def_property_readonly("phase", field_prop("phase"), "(n,) int32 phase index, copy in id order.")
       .def_property_readonly("kind", field_prop("kind"), "(n,) uint8: 0 fluid, 1 boundary; copy in id order.")
-      .def_property_readonly("id", field_prop("id"), "(n,) uint32 ids: 0..n-1, since every field is in id order.")
-      .def("fields", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fields(); }); },
-           "Every particle field (the library's field list: position, velocity, force, mass, density, pressure, "
-           "support, color, viscosity, phase, level, tick, kind, id) as copies in id order.")
-      .def_property_readonly("timings", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.timings(); }); },
-                             "Wall-clock time per phase of all steps so far [ms].");
+      .def_property_readonly("id", field_prop("id"),
+                             "(n,) uint32 ids: 0..n-1, since every field is in id order.")
+      .def(
+          "fields", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fields(); }); },
+          "Every particle field (the library's field list: position, velocity, force, mass, density, "
+          "pressure, "
+          "support, color, viscosity, phase, level, tick, kind, id) as copies in id order.")
+      .def_property_readonly(
+          "timings", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.timings(); }); },
+          "Wall-clock time per phase of all steps so far [ms].");
 }
 
 }  // namespace cellsph::python

@@ -99,7 +99,7 @@ def _read_index(folder: str):
     return path, header[2:], out
 
 
-def _csv_frame(path: str) -> Dict[str, np.ndarray]:
+def _csv_frame(path: str, dtype) -> Dict[str, np.ndarray]:
     with open(path, newline="") as f:
         header = f.readline().strip().split(",")
     values = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
@@ -122,11 +122,11 @@ def _csv_frame(path: str) -> Dict[str, np.ndarray]:
             stem, comps = name, None
         if comps is None:
             col = values[:, k]
-            out[stem] = col.astype(_INT_FIELDS[stem]) if stem in _INT_FIELDS else col
+            out[stem] = col.astype(_INT_FIELDS.get(stem, dtype))
             k += 1
         else:
             width = 3 if k + 2 < len(header) and header[k + 2] == comps[2] else 2
-            out[stem] = values[:, k : k + width].copy()
+            out[stem] = values[:, k : k + width].astype(dtype)
             k += width
     return out
 
@@ -137,7 +137,7 @@ _VTU_TYPES = {
 }
 
 
-def _vtu_frame(path: str) -> Dict[str, np.ndarray]:
+def _vtu_frame(path: str, _float_dtype=None) -> Dict[str, np.ndarray]:
     """A .vtu written by cellsph: raw appended data, UInt64 block headers, little endian."""
     with open(path, "rb") as f:
         blob = f.read()
@@ -166,14 +166,18 @@ def _vtu_frame(path: str) -> Dict[str, np.ndarray]:
     return out
 
 
-def read_frames(folder: PathLike, format: Optional[str] = None) -> Iterator[Tuple[float, Dict[str, Any]]]:
+def read_frames(
+    folder: PathLike, format: Optional[str] = None, dtype=np.float64
+) -> Iterator[Tuple[float, Dict[str, Any]]]:
     """Yields (time, fields) for every frame listed in FOLDER/frames.csv, in order.
 
     fields maps the particle field names of Simulation.fields() ("position", "velocity", "density",
     "pressure", "phase", "id", ...) to NumPy arrays, row k of every frame being the same particle.
-    format: "csv" (default when the run wrote CSV) or "vtu". CSV frames hold the fluid particles with
-    float64 columns (the text reads back the run's values exactly; int fields are cast back); VTU frames
-    hold every particle in the run's own dtypes, with vectors 3 wide (z = 0 in 2D), as ParaView reads them.
+    format: "csv" (default when the run wrote CSV) or "vtu". CSV frames hold the fluid particles; their
+    numbers are the shortest text that reads back the run's values exactly in the run's precision, so
+    float fields come as `dtype`: float64 (default) is exact for a double run, pass numpy.float32 for a
+    "precision": "float" run; integer fields get their own dtypes. VTU frames hold every particle in the
+    run's own dtypes (dtype is ignored), with vectors 3 wide (z = 0 in 2D), as ParaView reads them.
     """
     folder = os.fspath(folder)
     index_path, formats, rows = _read_index(folder)
@@ -184,4 +188,4 @@ def read_frames(folder: PathLike, format: Optional[str] = None) -> Iterator[Tupl
                          "read_frames reads csv and vtu)")
     reader = _csv_frame if format == "csv" else _vtu_frame
     for _frame, time, files in rows:
-        yield time, reader(os.path.join(folder, files[format]))
+        yield time, reader(os.path.join(folder, files[format]), dtype)

@@ -1,8 +1,8 @@
 #include "cellsph/io/simulation_checkpoint.hpp"
 
 #include <cstring>
-#include <utility>
 #include <type_traits>
+#include <utility>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/io/checkpoint.hpp"
