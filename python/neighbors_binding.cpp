@@ -177,6 +177,7 @@ class PyNeighborSearch {
   void build(const py::handle& points, std::optional<double> radius, const py::handle& h) {
     Query q = query_args(points, radius, h);
     std::lock_guard lock(mutex_);
+    built_ = false;  // until this build succeeds (a library error leaves the structure half built)
     dispatch(q, [&]<int Dim, class Real>() {
       using NS = NeighborSearch<Dim, Real>;
       if (!std::holds_alternative<NS>(ns_)) ns_.template emplace<NS>(opt_);
@@ -321,9 +322,9 @@ One search at a time per object (calls from several Python threads wait for each
       .def("count", &PyNeighborSearch::count_all, "Neighbours per point (int64) of the last build.")
       .def_property_readonly("stats", &PyNeighborSearch::stats,
                              "The last build/find_all: build_ms, query_ms, pairs, candidates, memory_bytes.")
-      .def_property_readonly("method", &PyNeighborSearch::method)
-      .def_property_readonly("subdivision", &PyNeighborSearch::subdivision)
-      .def_property_readonly("threads", &PyNeighborSearch::threads)
+      .def_property_readonly("method", &PyNeighborSearch::method, "The search method's name.")
+      .def_property_readonly("subdivision", &PyNeighborSearch::subdivision, "The subdivision factor H.")
+      .def_property_readonly("threads", &PyNeighborSearch::threads, "OpenMP threads (0 = all cores).")
       .def_property_readonly("size", &PyNeighborSearch::size, "Points of the last build (0 before).")
       .def_property_readonly("dim", &PyNeighborSearch::dim, "2 or 3 (None before the first build).")
       .def_property_readonly("dtype", &PyNeighborSearch::dtype,

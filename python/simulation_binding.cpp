@@ -423,9 +423,12 @@ Every error is a ValueError with the message of the command line (file or source
           "pointer"_a, "value"_a)
       .def(
           "to_dict", [](const PyScene& s) { return to_python(s.json); }, "The scene's JSON as a new dict.")
-      .def_property_readonly("name", [](const PyScene& s) { return s.header.name; })
-      .def_property_readonly("description", [](const PyScene& s) { return s.header.description; })
-      .def_property_readonly("dim", [](const PyScene& s) { return s.header.dim; })
+      .def_property_readonly(
+          "name", [](const PyScene& s) { return s.header.name; }, "The scene's name.")
+      .def_property_readonly(
+          "description", [](const PyScene& s) { return s.header.description; }, "One line.")
+      .def_property_readonly(
+          "dim", [](const PyScene& s) { return s.header.dim; }, "2 or 3.")
       .def_property_readonly("precision", &PyScene::precision, "'float' or 'double'.")
       .def_property_readonly(
           "source", [](const PyScene& s) { return s.source; },
@@ -500,16 +503,20 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
       .def_property_readonly(
           "dt", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.last_dt(); }); },
           "The last step's dt [s].")
-      .def_property_readonly("threads", [](const PySimulation& s) { return s.impl().threads(); })
+      .def_property_readonly(
+          "threads", [](const PySimulation& s) { return s.impl().threads(); },
+          "OpenMP threads of every call (0 = all cores).")
       .def_property_readonly(
           "scene", [](const PySimulation& s) { return s.impl().scene(); }, "A copy of the scene.")
-      .def_property_readonly("dim", [](const PySimulation& s) { return s.impl().scene().header.dim; })
+      .def_property_readonly(
+          "dim", [](const PySimulation& s) { return s.impl().scene().header.dim; }, "2 or 3.")
       .def_property_readonly(
           "size", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.size(); }); },
           "Particles, fluid and boundary.")
       .def_property_readonly(
           "fluid_count",
-          [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fluid_count(); }); })
+          [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fluid_count(); }); },
+          "Fluid particles (kind 0).")
       .def_property_readonly("positions", field_prop("position"), "(n, dim) positions [m], copy in id order.")
       .def_property_readonly(
           "velocities", field_prop("velocity"),
