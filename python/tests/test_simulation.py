@@ -41,14 +41,15 @@ def python_run(scene, out, frames, threads=2, formats="csv"):
     ],
 )
 def test_same_bits_as_cellsph_run(cellsph_binary, tmp_path, scene, sets):
-    frames = cli_run(cellsph_binary, tmp_path / "cli", scene, 0.03, sets=sets)
+    formats = "vtu,ply,csv"
+    frames = cli_run(cellsph_binary, tmp_path / "cli", scene, 0.03, sets=sets, formats=formats)
     assert frames == 4  # t = 0, 0.01, 0.02, 0.03
     s = cellsph.Scene.load(scene)
     for edit in sets:
         pointer, value = edit.split("=")
         s.set(pointer, json.loads(value))
-    python_run(s, tmp_path / "py", frames)
-    names = ["frames.csv"] + [f"frame_{k:05d}.csv" for k in range(frames)]
+    python_run(s, tmp_path / "py", frames, formats=formats)
+    names = ["frames.csv", "particles.pvd"] + [f"frame_{k:05d}.{e}" for k in range(frames) for e in ("vtu", "ply", "csv")]
     match, mismatch, errors = filecmp.cmpfiles(tmp_path / "cli", tmp_path / "py", names, shallow=False)
     assert mismatch == [] and errors == [], (mismatch, errors)
     assert match == names
