@@ -13,7 +13,7 @@ Points: n uniform random points in the unit cube (3D, float64), mean spacing s =
   scipy-ball   cKDTree(points) + query_ball_point(points, r, workers=T) + lists -> CSR (self kept)
   scipy-sdm    cKDTree(points) + sparse_distance_matrix(tree, r, output_type="coo_matrix") -> tocsr()
   scipy-pairs  cKDTree(points) + query_pairs(r, output_type="ndarray") -> symmetric CSR (sorted rows)
-cellsph and cli: the fastest of --repeat runs; SciPy paths: the fastest of --scipy-repeat runs (default
+cellsph and cli: the fastest of --repeat runs, taken in turns; SciPy paths: the fastest of --scipy-repeat runs (default
 1: they take seconds to minutes). The fastest run is the one least disturbed by other work on the machine;
 the load average is printed before and after. "binding overhead": for the same calls on a
 cellsph.NeighborSearch, wall time minus the library's own build_ms + query_ms (argument checks, the
@@ -72,19 +72,12 @@ def scipy_pairs(points, r, threads):
     return offsets, j[order]
 
 
-def cli_search_seconds(binary, points, r, threads, repeat):
-    with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "points.csv")
-        np.savetxt(path, points, fmt="%.17g", delimiter=",", header="x,y,z", comments="")
-        times = []
-        for _ in range(repeat):
-            out = subprocess.run([binary, "neighbors", "--input", path, "--radius", repr(r), "--threads",
-                                  str(threads), "--stats", "--counts", "--output", os.path.join(tmp, "c.csv")],
-                                 check=True, capture_output=True, text=True)
-            m = re.search(r"build_ms=([\d.]+) query_ms=([\d.]+) pairs=(\d+)", out.stderr)
-            times.append((float(m.group(1)) + float(m.group(2))) / 1000)
-            pairs = int(m.group(3))
-        return min(times), pairs
+def cli_search_seconds(binary, csv_path, out_dir, r, threads):
+    out = subprocess.run([binary, "neighbors", "--input", csv_path, "--radius", repr(r), "--threads", str(threads),
+                          "--stats", "--counts", "--output", os.path.join(out_dir, "counts.csv")],
+                         check=True, capture_output=True, text=True)
+    m = re.search(r"build_ms=([\d.]+) query_ms=([\d.]+) pairs=(\d+)", out.stderr)
+    return (float(m.group(1)) + float(m.group(2))) / 1000, int(m.group(3))
 
 
 def main():
@@ -106,11 +99,18 @@ def main():
     print(f"# {a.n} points, 3D float64, uniform in the unit cube; r = 2 spacings = {r:.6g}; {a.threads} threads")
     print(f"# load before: {os.getloadavg()}")
 
-    t_cellsph, pairs = float("inf"), 0
-    for _ in range(a.repeat):
-        t, (offsets, indices) = timed(lambda: cellsph.neighbors(points, radius=r, threads=a.threads))
-        t_cellsph, pairs = min(t_cellsph, t), len(indices)
-        del offsets, indices
+    # cellsph and the CLI alternate, so that both see the same share of a busy machine.
+    t_cellsph = t_cli = float("inf")
+    with tempfile.TemporaryDirectory() as tmp:
+        csv_path = os.path.join(tmp, "points.csv")
+        np.savetxt(csv_path, points, fmt="%.17g", delimiter=",", header="x,y,z", comments="")
+        for _ in range(a.repeat):
+            t, (offsets, indices) = timed(lambda: cellsph.neighbors(points, radius=r, threads=a.threads))
+            t_cellsph, pairs = min(t_cellsph, t), len(indices)
+            del offsets, indices
+            t, cli_pairs = cli_search_seconds(os.path.join(a.build, "cellsph"), csv_path, tmp, r, a.threads)
+            t_cli = min(t_cli, t)
+            assert cli_pairs == pairs, (cli_pairs, pairs)
     overhead = []
     for _ in range(a.repeat):
         ns = cellsph.NeighborSearch(threads=a.threads)
@@ -119,9 +119,6 @@ def main():
         del result
     print(f"cellsph      {t_cellsph:9.3f} s   {pairs} pairs ({pairs / a.n:.1f} per point); "
           f"binding overhead {1000 * min(overhead):.1f} to {1000 * max(overhead):.1f} ms")
-
-    t_cli, cli_pairs = cli_search_seconds(os.path.join(a.build, "cellsph"), points, r, a.threads, a.repeat)
-    assert cli_pairs == pairs, (cli_pairs, pairs)
     print(f"cli          {t_cli:9.3f} s   (build_ms + query_ms of --stats)")
 
     results = {}

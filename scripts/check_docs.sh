@@ -3,7 +3,7 @@
 # Usage: scripts/check_docs.sh BUILD_DIR
 # Commands are taken from fenced code blocks: lines starting with build/release/cellsph,
 # build/cellsph or PYTHONPATH=build/release/python (the Python module; comments after '#' dropped).
-# They run in a scratch folder that links the repo's scenes/ and the given build, after a small
+# They run in a scratch folder that links the repo's scenes/, scripts/ and the given build, after a small
 # points.csv is made for the `neighbors` examples.
 # Long runs are shortened by SHORTEN (appended to `run` commands that have no --until/--steps),
 # and `bench neighbors` or `bench sph` without --quick gets --quick, since CI has 2 cores.
@@ -16,6 +16,7 @@ mkdir -p "$scratch/build"
 ln -s "$build" "$scratch/build/release"
 for b in cellsph cellsph_tests cellsph_bench; do ln -s "$build/$b" "$scratch/build/$b"; done
 ln -s "$root/scenes" "$scratch/scenes"
+ln -s "$root/scripts" "$scratch/scripts"
 cd "$scratch"
 { echo "x,y,z"; for i in $(seq 0 199); do echo "$((i % 7)).$((i % 10)),$((i / 7 % 5)).$((i % 3)),$((i / 35)).5"; done; } > points.csv
 
