@@ -124,6 +124,7 @@ PYBIND11_MODULE(_cellsph, m) {
   namespace py = pybind11;
   using namespace cellsph::python;
   m.doc() = "cellsph: exact fixed-radius neighbour search (Cell Indexing) and the SPH simulator, for NumPy.";
+  m.attr("__version__") = CELLSPH_VERSION;
 
   static py::exception<cellsph::SimulationError> simulation_error(m, "SimulationError", PyExc_RuntimeError);
   simulation_error.doc() =

@@ -21,6 +21,7 @@ from typing import Any, Dict, Iterator, Optional, Tuple, Union
 import numpy as np
 
 from ._cellsph import (
+    __version__,
     NeighborSearch,
     Scene,
     Simulation,

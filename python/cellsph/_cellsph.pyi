@@ -8,6 +8,8 @@ import numpy.typing as npt
 _Points = npt.ArrayLike  # (n, 2) or (n, 3), float32 or float64
 _Path = Union[str, os.PathLike[str]]
 
+__version__: str
+
 class SimulationError(RuntimeError): ...
 
 def max_threads() -> int: ...
