@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Runs every `cellsph` command shown in README.md and docs/*.md, so the docs stay true.
 # Usage: scripts/check_docs.sh BUILD_DIR
-# Commands are taken from fenced code blocks: lines starting with build/release/cellsph or
-# build/cellsph (comments after '#' dropped). They run in a scratch folder that links the repo's
-# scenes/ and the given build, after a small points.csv is made for the `neighbors` examples.
+# Commands are taken from fenced code blocks: lines starting with build/release/cellsph,
+# build/cellsph or PYTHONPATH=build/release/python (the Python module; comments after '#' dropped).
+# They run in a scratch folder that links the repo's scenes/, scripts/ and the given build, after a small
+# points.csv is made for the `neighbors` examples.
 # Long runs are shortened by SHORTEN (appended to `run` commands that have no --until/--steps),
 # and `bench neighbors` or `bench sph` without --quick gets --quick, since CI has 2 cores.
 set -euo pipefail
@@ -15,6 +16,7 @@ mkdir -p "$scratch/build"
 ln -s "$build" "$scratch/build/release"
 for b in cellsph cellsph_tests cellsph_bench; do ln -s "$build/$b" "$scratch/build/$b"; done
 ln -s "$root/scenes" "$scratch/scenes"
+ln -s "$root/scripts" "$scratch/scripts"
 cd "$scratch"
 { echo "x,y,z"; for i in $(seq 0 199); do echo "$((i % 7)).$((i % 10)),$((i / 7 % 5)).$((i % 3)),$((i / 35)).5"; done; } > points.csv
 
@@ -36,6 +38,6 @@ while IFS= read -r line; do
   if ! bash -c "$cmd" </dev/null >"$scratch/out.txt" 2>&1; then
     echo "FAILED: $cmd"; tail -5 "$scratch/out.txt"; fail=$((fail + 1))
   fi
-done < <(awk '/^```/{inb=!inb; next} inb && /^(build\/release\/cellsph|build\/cellsph)/' "$root/README.md" "$root"/docs/*.md)
+done < <(awk '/^```/{inb=!inb; next} inb && /^(build\/release\/cellsph|build\/cellsph|PYTHONPATH=build\/release\/python )/' "$root/README.md" "$root"/docs/*.md)
 echo "docs: $((n - fail)) passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -13,12 +13,15 @@ cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build/release -j "$JOBS"
 ctest --test-dir build/release -j "$JOBS" --output-on-failure
 
+echo "== Python module (Debian's python3, the release build) =="
+CELLSPH_BUILD=build/release /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests
+
 echo "== commands of README.md and docs/ =="
 scripts/check_docs.sh build/release
 
 echo "== ASan + UBSan build =="
 cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLSPH_SANITIZE=ON \
-  -DCELLSPH_BUILD_BENCHMARKS=OFF >/dev/null
+  -DCELLSPH_BUILD_BENCHMARKS=OFF -DCELLSPH_BUILD_PYTHON=OFF >/dev/null
 cmake --build build/asan -j "$JOBS"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/asan -j "$JOBS" --output-on-failure

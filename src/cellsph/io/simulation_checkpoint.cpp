@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <type_traits>
+#include <utility>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/io/checkpoint.hpp"
@@ -66,10 +67,12 @@ void write_simulation_checkpoint(const Simulation<Dim, Real>& sim, std::string_v
   write_checkpoint(sim.particles(), info, path);
 }
 
-template <int Dim, class Real>
-std::string read_simulation_checkpoint(const std::filesystem::path& path, Simulation<Dim, Real>& sim) {
-  Particles<Dim, Real> particles;
-  const CheckpointInfo info = read_checkpoint(path, particles);
+namespace {
+
+// The blob of `info` (see the header): the integrator state and the caller's bytes.
+template <class Real>
+std::pair<IntegratorState<Real>, std::string> parse_blob(const std::filesystem::path& path,
+                                                         const CheckpointInfo& info) {
   BlobReader r(path, info.user);
   if (info.user.size() < sizeof kBlobMagic ||
       std::memcmp(info.user.data(), kBlobMagic, sizeof kBlobMagic) != 0)
@@ -89,8 +92,31 @@ std::string read_simulation_checkpoint(const std::filesystem::path& path, Simula
   const auto n = r.get<std::uint64_t>("the caller data length");
   std::string extra(r.bytes(static_cast<std::size_t>(n), "the caller data"));
   if (r.left()) r.fail(std::to_string(r.left()) + " unexpected bytes at the end");
+  return {st, std::move(extra)};
+}
+
+template <int Dim, class Real>
+std::string read_extra(const std::filesystem::path& path) {
+  Particles<Dim, Real> particles;
+  return parse_blob<Real>(path, read_checkpoint(path, particles)).second;
+}
+
+}  // namespace
+
+template <int Dim, class Real>
+std::string read_simulation_checkpoint(const std::filesystem::path& path, Simulation<Dim, Real>& sim) {
+  Particles<Dim, Real> particles;
+  const CheckpointInfo info = read_checkpoint(path, particles);
+  auto [st, extra] = parse_blob<Real>(path, info);
   sim.restore(std::move(particles), st, "checkpoint '" + path.string() + "'");
   return extra;
+}
+
+std::string read_simulation_checkpoint_extra(const std::filesystem::path& path) {
+  const CheckpointHeader h = read_checkpoint_header(path);
+  const bool f32 = h.real_size == 4;
+  if (h.dim == 2) return f32 ? read_extra<2, float>(path) : read_extra<2, double>(path);
+  return f32 ? read_extra<3, float>(path) : read_extra<3, double>(path);
 }
 
 #define CELLSPH_SIMULATION_CHECKPOINT_INSTANTIATE(D, R)                                      \

@@ -27,4 +27,9 @@ void write_simulation_checkpoint(const Simulation<Dim, Real>& sim, std::string_v
 template <int Dim, class Real>
 std::string read_simulation_checkpoint(const std::filesystem::path& path, Simulation<Dim, Real>& sim);
 
+// The caller's bytes of a simulation checkpoint of any dimension and precision, validated like
+// read_simulation_checkpoint but restoring nothing: what a caller stored there may say how to build the
+// Simulation to restore into (the Python module keeps the scene there). Throws InputError naming the file.
+std::string read_simulation_checkpoint_extra(const std::filesystem::path& path);
+
 }  // namespace cellsph

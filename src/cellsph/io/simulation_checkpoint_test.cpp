@@ -85,6 +85,8 @@ void resume_is_bit_identical(Model model) {
   EXPECT_EQ(header.time, double(full.time()));
   for (int s = 0; s < 20; ++s) full.step();
 
+  // The caller's bytes alone, without a Simulation to restore into (the Python module's resume).
+  EXPECT_EQ(read_simulation_checkpoint_extra(dir / "c.ckpt"), extra);
   Simulation<Dim, Real> resumed(cfg, block<Dim, Real>(5));
   EXPECT_EQ(read_simulation_checkpoint(dir / "c.ckpt", resumed), extra);
   EXPECT_EQ(resumed.steps(), 20u);
@@ -150,6 +152,24 @@ TEST(SimulationCheckpoint, MismatchesAreInputErrorsNamingTheFile) {
       << m;
   EXPECT_TRUE(same_fields(before, b.particles()));
   EXPECT_EQ(load_error(dir / "a.ckpt", a), "no error");
+
+  // read_simulation_checkpoint_extra validates the same way, for any dimension and precision.
+  auto extra_error = [](const std::filesystem::path& path) -> std::string {
+    try {
+      return "no error: '" + read_simulation_checkpoint_extra(path) + "'";
+    } catch (const InputError& e) {
+      return e.what();
+    }
+  };
+  EXPECT_EQ(extra_error(dir / "3d.ckpt"), "no error: ''");
+  EXPECT_EQ(extra_error(dir / "f.ckpt"), "no error: ''");
+  m = extra_error(dir / "bare.ckpt");
+  EXPECT_NE(m.find((dir / "bare.ckpt").string() + "': integrator state: missing"), std::string::npos) << m;
+  m = extra_error(dir / "short.ckpt");
+  EXPECT_NE(m.find("integrator state: the user data ends (9 bytes) inside the version"), std::string::npos)
+      << m;
+  m = extra_error(dir / "nothing.ckpt");
+  EXPECT_NE(m.find((dir / "nothing.ckpt").string()), std::string::npos) << m;
 }
 
 }  // namespace
