@@ -238,9 +238,10 @@ def test_bad_arguments_of_the_search_object():
     with pytest.raises(ValueError, match="radius: must be a finite number > 0, got -3"):
         ns.build(GOOD, radius=-3.0)
     assert ns.size == 0  # nothing was built
-    # A capacity the library checks (cells per axis of a key) is a ValueError too, and leaves no half-built search.
-    ns.build(GOOD, radius=1.0)
-    with pytest.raises(ValueError, match="cell-index: .* cells along axis 0 .* exceed the 2\\^32 cells per axis"):
-        ns.build(np.array([[0, 0, 0], [1e30, 0, 0]]), radius=1e-20)
+    # Points far beyond what a key's cells span are searched exactly (the grid is cut at its last cell).
+    ns.build(np.array([[0, 0, 0], [1e30, 0, 0], [1e30, 0, 1e-21]]), radius=1e-20)
+    offsets, indices = ns.find_all()
+    assert offsets.tolist() == [0, 0, 1, 2] and indices.tolist() == [2, 1]
+    ns = cellsph.NeighborSearch()
     with pytest.raises(ValueError, match="call build"):
         ns.find_all()
