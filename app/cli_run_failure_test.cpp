@@ -435,6 +435,100 @@ TEST(CliRunWriteFailure, PngAndSurfaceFailuresNameTheFile) {
   }
 }
 
+// At 1000 frames per second and dt = 0.002 s two frames fall in one step, with a checkpoint after each:
+// a run stopped between them resumes from a checkpoint whose next frame is already due. Every fault
+// position through the first steps, each resumed: the same bits as the run that never failed.
+TEST(CliRunWriteFailure, ResumeBetweenTwoFramesOfOneStep) {
+  TempDir dir;
+  std::string scene = kTiny;
+  scene.replace(scene.find("\"fps\": 50"), 9, "\"fps\": 1000");
+  write_file(dir / "fast.json", scene);
+  const std::string common = " --quiet --threads 2 --until 0.012 --format csv";
+  auto r = run_cli(dir, "run " + q(dir / "fast.json") + " --out " + q(dir / "ref") + common);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto ref = files_of(dir / "ref");
+  ASSERT_NE(read_file(dir / "ref" / "frames.csv").find("\n2,0.002,"), std::string::npos)
+      << "frames 1 and 2 should share a step:\n"
+      << read_file(dir / "ref" / "frames.csv");
+  // run.json, then per frame: frame_NNNNN.csv, frames.csv, checkpoint.bin.
+  for (int n = 1; n <= 24; ++n) {
+    SCOPED_TRACE("CELLSPH_FAIL_WRITE_AFTER=" + std::to_string(n));
+    const fs::path out = dir / ("f" + std::to_string(n));
+    {
+      ScopedEnv fault("CELLSPH_FAIL_WRITE_AFTER", std::to_string(n));
+      r = run_cli(dir, "run " + q(dir / "fast.json") + " --out " + q(out) + common);
+    }
+    ASSERT_EQ(r.code, 4) << r.err;
+    r = run_cli(dir, "run --resume " + q(out) + " --quiet --threads 2");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto got = files_of(out);
+    EXPECT_TRUE(got == ref) << differences(got, ref);
+  }
+}
+
+// The folder removed under a running run: code 4 and the system's reason, not a crash.
+TEST(CliRunWriteFailure, FolderRemovedUnderTheRun) {
+  TempDir dir;
+  write_file(dir / "tiny.json", kTiny);
+  const fs::path out = dir / "run";
+  const pid_t pid = spawn_cli({"run", (dir / "tiny.json").string(), "--out", out.string(), "--quiet",
+                               "--until", "1", "--fps", "100", "--threads", "2"},
+                              dir / "log");
+  ASSERT_GT(pid, 0);
+  for (int i = 0; i < 100000 && !fs::exists(out / "frames.csv"); ++i)
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  for (int i = 0; i < 1000 && fs::exists(out); ++i) {
+    std::error_code ec;
+    fs::remove_all(out, ec);  // may race with a file being made: try again
+  }
+  const int code = wait_for(pid);
+  const std::string text = read_file(dir / "log");
+  EXPECT_EQ(code, 4) << text;
+  EXPECT_EQ(count_lines(text), 1u) << text;
+  EXPECT_NE(text.find("cannot write '" + out.string() + "/"), std::string::npos) << text;
+  EXPECT_NE(text.find("No such file or directory"), std::string::npos) << text;
+}
+
+// A real full disk: a 64 KiB tmpfs in a private mount namespace (unshare -rm: no privileges needed where
+// the kernel allows user namespaces). Then the space is freed (remount larger) and the run resumed.
+TEST(CliRunWriteFailure, RealFullDiskThenResumeWhenFreed) {
+  TempDir dir;
+  if (std::system("unshare -rm true >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "no private mount namespace here (unshare -rm); the injected faults above cover this";
+  write_file(dir / "tiny.json", kTiny);
+  auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "ref") + " --quiet --threads 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  fs::create_directories(dir / "mnt");
+  const std::string bin = q(CELLSPH_BINARY), m = q(dir / "mnt"), d = dir.path().string();
+  const std::string script = "mount -t tmpfs -o size=64k none " + m + " || exit 99; " + bin + " run " +
+                             q(dir / "tiny.json") + " --out " + m + "/run --quiet --threads 2 2>'" + d +
+                             "/err1'; echo $? >'" + d + "/code1'; cp -r " + m + "/run '" + d +
+                             "/full'; mount -o remount,size=16m " + m + " || exit 98; " + bin +
+                             " run --resume " + m + "/run --quiet --threads 2 2>'" + d +
+                             "/err2'; echo $? >'" + d + "/code2'; cp -r " + m + "/run '" + d + "/freed'";
+  const std::string cmd = "unshare -rm sh -c " + q(script);
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const std::string err1 = read_file(dir / "err1");
+  EXPECT_EQ(read_file(dir / "code1"), "4\n") << err1;
+  EXPECT_EQ(count_lines(err1), 1u) << err1;
+  EXPECT_NE(err1.find("No space left on device"), std::string::npos) << err1;
+  EXPECT_EQ(err1.find("injected"), std::string::npos) << err1;
+  const auto ref = files_of(dir / "ref");
+  const std::string index = read_file(dir / "full" / "frames.csv");
+  int listed = 0;
+  for (const auto& [name, bytes] : files_of(dir / "full")) {
+    EXPECT_EQ(name.find(".tmp"), std::string::npos) << name;
+    if (name.rfind("frame_", 0) == 0 && index.find(name) != std::string::npos) {
+      ++listed;
+      EXPECT_TRUE(bytes == ref.at(name)) << name;
+    }
+  }
+  EXPECT_GT(listed, 0) << "the disk filled before the first frame: make the tmpfs larger";
+  EXPECT_EQ(read_file(dir / "code2"), "0\n") << read_file(dir / "err2");
+  const auto got = files_of(dir / "freed");
+  EXPECT_TRUE(got == ref) << differences(got, ref);
+}
+
 // =======================================================================================================
 // 4. Stop at any moment.
 
