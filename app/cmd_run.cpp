@@ -286,8 +286,9 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
       write_checkpoint();
     output_ms += sw.ms();
   };
-  // Frames due at the current time: frame 0 of a new run; on a resume, those a checkpoint taken between
-  // two frames of one step left unwritten (none in the common case).
+  // Every frame due at the current time: after a step, one or more (fps above 1 / dt); at the start,
+  // frame 0 of a new run, or on a resume those that a checkpoint taken between two frames of one step
+  // left unwritten (none in the common case).
   auto write_due_frames = [&] {
     while (double(sim.time()) >= double(loop.next_frame) * frame_dt * (1 - 1e-12)) write_frame();
   };
@@ -298,22 +299,27 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
                  sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
                  std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
 
-  write_due_frames();
   auto done = [&] {
     if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
     return double(sim.time()) >= os.end_time * (1 - 1e-12);
   };
-  while (!done() && !g_stop_signal) {
-    sim.step();
+  try {
     write_due_frames();
-    const double frac = opt.steps >= 0
-                            ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
-                            : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
-    const double w = wall.seconds();
-    progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
-                              " s  frame " + std::to_string(loop.next_frame) + "  " +
-                              fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
-                              " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles");
+    while (!done() && !g_stop_signal) {
+      sim.step();
+      write_due_frames();
+      const double frac =
+          opt.steps >= 0 ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
+                         : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
+      const double w = wall.seconds();
+      progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
+                                " s  frame " + std::to_string(loop.next_frame) + "  " +
+                                fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
+                                " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles");
+    }
+  } catch (...) {
+    progress.finish();  // the error's line starts on a line of its own
+    throw;
   }
   progress.finish();
   if (const int sig = g_stop_signal) {
