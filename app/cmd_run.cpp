@@ -420,10 +420,10 @@ int run_command(RunOptions opt) {
   // Called by run_scene once everything is valid: the first writes of the run.
   const bool new_run = opt.resume.empty();
   auto start_output = [&] {
-    if (!new_run) {
-      for (const auto& d : {out, out / "png", out / "surface"}) remove_stale_temporaries(d);
-      return;
-    }
+    // What writers killed in this folder before left (a run killed mid-write, then resumed or started
+    // again into the same folder).
+    for (const auto& d : {out, out / "png", out / "surface"}) remove_stale_temporaries(d);
+    if (!new_run) return;
     make_folder(out);
     nlohmann::json saved;
     saved["scene"] = scene_json;
