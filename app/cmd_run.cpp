@@ -1,6 +1,8 @@
 // `cellsph run [SCENE]` and `cellsph scenes`: run a scene from the command line, writing frames that
 // ParaView (VTU + PVD), Blender (PLY) and scripts (CSV, frames.csv) open, optional PNG pictures and an
-// MP4, checkpoints, and a resume that continues bit for bit.
+// MP4, checkpoints, and a resume that continues bit for bit. A run checks and builds everything before
+// its first write (a failed start leaves the output location as it was), and stops cleanly on SIGINT or
+// SIGTERM (a checkpoint, then exit 130 or 143).
 #include <signal.h>
 #include <sys/types.h>
 

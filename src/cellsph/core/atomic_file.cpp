@@ -194,7 +194,7 @@ AtomicFile::~AtomicFile() {
 void AtomicFile::fail(const std::string& what, int err) {
   std::string msg = "cannot write '" + target_.string() + "': ";
   if (!what.empty()) msg += what + ": ";
-  msg += std::strerror(err);
+  msg += std::generic_category().message(err);
   if (buf_ && buf_->injected()) msg += " (injected by CELLSPH_FAIL_WRITE_AFTER)";
   throw WriteError(msg);
 }
