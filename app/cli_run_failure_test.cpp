@@ -490,8 +490,12 @@ TEST(CliRunWriteFailure, FolderRemovedUnderTheRun) {
 // the kernel allows user namespaces). Then the space is freed (remount larger) and the run resumed.
 TEST(CliRunWriteFailure, RealFullDiskThenResumeWhenFreed) {
   TempDir dir;
-  if (std::system("unshare -rm true >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "no private mount namespace here (unshare -rm); the injected faults above cover this";
+  fs::create_directories(dir / "probe");
+  write_file(dir / "probe.sh", "mount -t tmpfs -o size=64k none " + q(dir / "probe") + "\n");
+  const std::string probe = "unshare -rm sh " + q(dir / "probe.sh") + " >/dev/null 2>&1";
+  if (std::system(probe.c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs in a private mount namespace here (unshare -rm); the injected "
+                    "faults above cover this";
   write_file(dir / "tiny.json", kTiny);
   auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "ref") + " --quiet --threads 2");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -503,7 +507,8 @@ TEST(CliRunWriteFailure, RealFullDiskThenResumeWhenFreed) {
                              "/full'; mount -o remount,size=16m " + m + " || exit 98; " + bin +
                              " run --resume " + m + "/run --quiet --threads 2 2>'" + d +
                              "/err2'; echo $? >'" + d + "/code2'; cp -r " + m + "/run '" + d + "/freed'";
-  const std::string cmd = "unshare -rm sh -c " + q(script);
+  write_file(dir / "full.sh", script + "\n");
+  const std::string cmd = "unshare -rm sh " + q(dir / "full.sh");
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const std::string err1 = read_file(dir / "err1");
   EXPECT_EQ(read_file(dir / "code1"), "4\n") << err1;
