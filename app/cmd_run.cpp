@@ -1,11 +1,21 @@
 // `cellsph run [SCENE]` and `cellsph scenes`: run a scene from the command line, writing frames that
 // ParaView (VTU + PVD), Blender (PLY) and scripts (CSV, frames.csv) open, optional PNG pictures and an
-// MP4, checkpoints, and a resume that continues bit for bit.
+// MP4, checkpoints, and a resume that continues bit for bit. A run checks and builds everything before
+// its first write (a failed start leaves the output location as it was), and stops cleanly on SIGINT or
+// SIGTERM (a checkpoint, then exit 130 or 143).
+#include <signal.h>
+#include <sys/types.h>
+
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -108,9 +118,88 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
+// ---- Stopping on SIGINT / SIGTERM ------------------------------------------------------------------
+// The handler only records the signal (async-signal-safe); the run loop looks at it between steps,
+// writes a checkpoint and returns 128 + the signal. SA_RESETHAND: a second Ctrl-C kills at once.
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int sig) {
+  g_stop_signal = sig;
+}
+
+void install_stop_handlers() {
+  g_stop_signal = 0;
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND | SA_RESTART;
+  ::sigaction(SIGINT, &sa, nullptr);
+  ::sigaction(SIGTERM, &sa, nullptr);
+}
+
+const char* signal_name(int sig) {
+  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal";
+}
+
+// A word the shell reads back unchanged.
+std::string shell_word(const std::string& s) {
+  const bool plain = !s.empty() && s.find_first_not_of(
+                                       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                       "0123456789_./+-=:,@%") == std::string::npos;
+  if (plain) return s;
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string shortest(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return {buf, r.ptr};
+}
+
+// The command that continues this run: the folder, plus what this invocation set that run.json does not
+// keep (the thread count, and the overrides given to a --resume).
+std::string resume_command(const RunOptions& given, const std::filesystem::path& out) {
+  std::string c = shell_word(program_name()) + " run --resume " + shell_word(out.string());
+  if (given.threads > 0) c += " --threads " + std::to_string(given.threads);
+  if (!given.resume.empty()) {
+    if (given.until > 0) c += " --until " + shortest(given.until);
+    if (given.steps >= 0) c += " --steps " + std::to_string(given.steps);
+    if (given.fps > 0) c += " --fps " + shortest(given.fps);
+    if (!given.method.empty()) c += " --method " + shell_word(given.method);
+    if (!given.formats.empty()) c += " --format " + shell_word(given.formats);
+    if (given.render) c += " --render";
+    if (!given.color_by.empty()) c += " --color-by " + shell_word(given.color_by);
+    if (given.surface) c += " --surface";
+  }
+  return c;
+}
+
+// Removes the temporary files of killed writers (AtomicFile names; never those of a live process).
+void remove_stale_temporaries(const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  std::vector<std::filesystem::path> stale;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!is_atomic_temp_name(name)) continue;
+    const auto tmp = name.rfind(".tmp");
+    const long pid = std::strtol(name.c_str() + tmp + 4, nullptr, 10);
+    if (pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM)) continue;  // alive
+    stale.push_back(e.path());
+  }
+  for (const auto& p : stale) std::filesystem::remove(p, ec);
+}
+
+// Runs one scene. Two phases: first everything is read, validated and built (scene, options,
+// particles, Simulation, the checkpoint and the frame index of a resume) without writing anything, so a
+// failed start leaves the output location as it was; then `start_output` makes the folder and run.json,
+// and the frames follow.
 template <int Dim, class Real>
 int run_scene(const nlohmann::json& scene_json, const std::string& source, const RunOptions& opt,
-              const std::filesystem::path& out, bool resuming) {
+              const RunOptions& given, const std::filesystem::path& out, bool resuming,
+              const std::function<void()>& start_output) {
   Scene<Dim, Real> scene = load_scene<Dim, Real>(scene_json, source);
   auto& cfg = scene.solver;
   if (!opt.method.empty()) {
@@ -132,14 +221,24 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     formats = list.empty() ? OutputFormats{} : parse_output_formats(list, "output.formats");
   }
   if (!opt.color_by.empty()) os.color_by = opt.color_by;
+  RenderOptions ropt;
+  ropt.color_by = parse_color_by(os.color_by, "--color-by");
+  ropt.up_axis = os.up_axis;
+  SurfaceOptions sopt;
+  sopt.format = parse_surface_format(opt.surface_format);
+  sopt.threads = max_threads();
+  validate(sopt);
 
-  make_folder(out);
   Simulation<Dim, Real> sim(cfg, std::move(scene.particles));
   const auto& parts = sim.particles();
   auto is_fluid = [&parts](std::size_t i) {
     return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid);
   };
-  FrameOutput<Dim, Real> frames(out, formats, is_fluid);
+  ropt.visible = is_fluid;
+  RenderBox rbox;
+  rbox.lo = scene.view_lo;
+  rbox.hi = scene.view_hi;
+  FrameOutput<Dim, Real> frames(out, formats, is_fluid);  // writes nothing yet
 
   LoopState loop;
   const auto ckpt_path = out / kCheckpointFile;
@@ -157,20 +256,16 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     frames.resume(loop.next_frame);
   }
 
-  RenderOptions ropt;
-  ropt.color_by = parse_color_by(os.color_by, "--color-by");
-  ropt.up_axis = os.up_axis;
-  ropt.visible = is_fluid;
-  RenderBox rbox;
-  rbox.lo = scene.view_lo;
-  rbox.hi = scene.view_hi;
+  // ---- Everything is valid: from here on the run writes.
+  if (g_stop_signal) {
+    std::fprintf(stderr, "cellsph: stopped by %s before the run started; nothing was written\n",
+                 signal_name(g_stop_signal));
+    return 128 + g_stop_signal;
+  }
+  start_output();
   const auto png_dir = out / "png";
-  if (opt.render) make_folder(png_dir);
-  SurfaceOptions sopt;
-  sopt.format = parse_surface_format(opt.surface_format);
-  sopt.threads = max_threads();
-  validate(sopt);
   const auto surface_dir = out / "surface";
+  if (opt.render) make_folder(png_dir);
   if (opt.surface) make_folder(surface_dir);
 
   Progress progress(opt.quiet);
@@ -193,6 +288,12 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
       write_checkpoint();
     output_ms += sw.ms();
   };
+  // Every frame due at the current time: after a step, one or more (fps above 1 / dt); at the start,
+  // frame 0 of a new run, or on a resume those that a checkpoint taken between two frames of one step
+  // left unwritten (none in the common case).
+  auto write_due_frames = [&] {
+    while (double(sim.time()) >= double(loop.next_frame) * frame_dt * (1 - 1e-12)) write_frame();
+  };
 
   if (!opt.quiet)
     std::fprintf(stderr, "cellsph: %s (%s): %zu particles (%zu fluid), %dD %s, %s, %s, %d threads -> %s\n",
@@ -200,24 +301,41 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
                  sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
                  std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
 
-  if (!resuming) write_frame();
   auto done = [&] {
     if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
     return double(sim.time()) >= os.end_time * (1 - 1e-12);
   };
-  while (!done()) {
-    sim.step();
-    while (double(sim.time()) >= double(loop.next_frame) * frame_dt * (1 - 1e-12)) write_frame();
-    const double frac = opt.steps >= 0
-                            ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
-                            : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
-    const double w = wall.seconds();
-    progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
-                              " s  frame " + std::to_string(loop.next_frame) + "  " +
-                              fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
-                              " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles");
+  try {
+    write_due_frames();
+    while (!done() && !g_stop_signal) {
+      sim.step();
+      write_due_frames();
+      const double frac =
+          opt.steps >= 0 ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
+                         : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
+      const double w = wall.seconds();
+      progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
+                                " s  frame " + std::to_string(loop.next_frame) + "  " +
+                                fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
+                                " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles");
+    }
+  } catch (...) {
+    progress.finish();  // the error's line starts on a line of its own
+    throw;
   }
   progress.finish();
+  if (const int sig = g_stop_signal) {
+    // Stopped between two steps: the state after the last step, with its frame counter, so the resume
+    // continues exactly as the run would have (frames after the last one written follow on resume).
+    write_checkpoint();
+    std::fprintf(stderr,
+                 "cellsph: stopped by %s at t = %.6g s, step %llu, after frame %llu, in %s; checkpoint "
+                 "written\ncellsph: to continue: %s\n",
+                 signal_name(sig), double(sim.time()), static_cast<unsigned long long>(sim.steps()),
+                 static_cast<unsigned long long>(loop.next_frame) - 1, out.string().c_str(),
+                 resume_command(given, out).c_str());
+    return 128 + sig;
+  }
   // The end state too, so that a finished run can be extended with --resume DIR --until LATER.
   if (os.checkpoint_every > 0) {
     Stopwatch sw;
@@ -249,6 +367,9 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
 }
 
 int run_command(RunOptions opt) {
+  // From the start, so that a Ctrl-C while the scene loads still ends with code 130 and nothing written.
+  install_stop_handlers();
+  const RunOptions given = opt;
   nlohmann::json scene_json;
   std::string source;
   std::filesystem::path out;
@@ -290,7 +411,7 @@ int run_command(RunOptions opt) {
   if (out.empty())
     out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
 
-  // Option errors come before anything is written.
+  // Option errors come before the scene is built.
   parse_surface_format(opt.surface_format);
   if (!opt.method.empty() && !parse_method(opt.method))
     throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() +
@@ -298,8 +419,13 @@ int run_command(RunOptions opt) {
   if (!opt.formats.empty()) parse_output_formats(opt.formats, "--format");
   if (!opt.color_by.empty()) parse_color_by(opt.color_by, "--color-by");
 
-  ScopedThreads threads(opt.threads);
-  if (!resuming) {
+  // Called by run_scene once everything is valid: the first writes of the run.
+  const bool new_run = opt.resume.empty();
+  auto start_output = [&] {
+    // What writers killed in this folder before left (a run killed mid-write, then resumed or started
+    // again into the same folder).
+    for (const auto& d : {out, out / "png", out / "surface"}) remove_stale_temporaries(d);
+    if (!new_run) return;
     make_folder(out);
     nlohmann::json saved;
     saved["scene"] = scene_json;
@@ -309,12 +435,16 @@ int run_command(RunOptions opt) {
         {"until", opt.until},       {"steps", opt.steps},     {"render", opt.render},
         {"color_by", opt.color_by}, {"surface", opt.surface}, {"surface_format", opt.surface_format}};
     write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
-  }
+  };
+
+  ScopedThreads threads(opt.threads);
   if (header.dim == 2)
-    return header.single_precision ? run_scene<2, float>(scene_json, source, opt, out, resuming)
-                                   : run_scene<2, double>(scene_json, source, opt, out, resuming);
-  return header.single_precision ? run_scene<3, float>(scene_json, source, opt, out, resuming)
-                                 : run_scene<3, double>(scene_json, source, opt, out, resuming);
+    return header.single_precision
+               ? run_scene<2, float>(scene_json, source, opt, given, out, resuming, start_output)
+               : run_scene<2, double>(scene_json, source, opt, given, out, resuming, start_output);
+  return header.single_precision
+             ? run_scene<3, float>(scene_json, source, opt, given, out, resuming, start_output)
+             : run_scene<3, double>(scene_json, source, opt, given, out, resuming, start_output);
 }
 
 }  // namespace

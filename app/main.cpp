@@ -9,7 +9,11 @@
 #include "cellsph/core/error.hpp"
 #include "commands.hpp"
 
+// Exit codes (README.md "Exit codes"): 0 done, 1 internal error or out of memory, 2 bad input (scene,
+// option, input file, checkpoint, a capacity limit the input goes beyond), 3 unstable simulation, 4 an
+// output file could not be written, 130 / 143 a run stopped by SIGINT / SIGTERM (app/cmd_run.cpp).
 int main(int argc, char** argv) {
+  cellsph::app::program_name() = argc > 0 && argv[0] && *argv[0] ? argv[0] : "cellsph";
   CLI::App app{"cellsph: particle fluids (SPH) on the fastest exact neighbour search", "cellsph"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "cellsph 0.1.0");
@@ -30,6 +34,11 @@ int main(int argc, char** argv) {
     // to work around (another method, another radius or spacing), so reported as bad input.
     std::cerr << "cellsph: error: " << e.what() << "\n";
     return 2;
+  } catch (const cellsph::WriteError& e) {
+    // An output file that could not be written (full disk, no permission, folder removed): the files
+    // written before it and the last checkpoint stay valid (atomic writes), so a --resume continues.
+    std::cerr << "cellsph: error: " << e.what() << "\n";
+    return 4;
   } catch (const cellsph::SimulationError& e) {
     std::cerr << "cellsph: simulation stopped: " << e.what() << "\n";
     return 3;

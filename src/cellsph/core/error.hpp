@@ -20,6 +20,13 @@ class SimulationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// An output file could not be written (no space, no permission, the folder removed under the run). The
+// message names the file and the system's reason. The CLI exits with code 4.
+class WriteError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // A capacity of a data structure was exceeded (e.g. bits of a Cell Indexing key).
 class CapacityError : public std::runtime_error {
  public:

@@ -14,11 +14,7 @@ FrameOutput<Dim, Real>::FrameOutput(std::filesystem::path dir, OutputFormats for
       formats_(formats),
       fluid_(std::move(fluid)),
       index_(dir_ / "frames.csv", formats.names()),
-      pvd_(dir_ / pvd_name) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir_, ec);
-  if (ec) throw InputError("cannot create output folder '" + dir_.string() + "': " + ec.message());
-}
+      pvd_(dir_ / pvd_name) {}
 
 template <int Dim, class Real>
 void FrameOutput<Dim, Real>::resume(std::size_t next_frame) {
@@ -50,6 +46,12 @@ void FrameOutput<Dim, Real>::resume(std::size_t next_frame) {
 template <int Dim, class Real>
 std::vector<std::filesystem::path> FrameOutput<Dim, Real>::write(const Particles<Dim, Real>& particles,
                                                                  std::size_t frame, double time) {
+  if (!dir_made_) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir_, ec);
+    if (ec) throw WriteError("cannot create output folder '" + dir_.string() + "': " + ec.message());
+    dir_made_ = true;
+  }
   std::vector<std::filesystem::path> written;
   FrameRow row{frame, time, {}};
   const Particles<Dim, Real>* out = &particles;

@@ -19,11 +19,14 @@ namespace cellsph {
 template <int Dim, class Real>
 class FrameOutput {
  public:
-  // Creates `dir` if needed. `fluid` selects the CSV rows (empty = all particles; must be thread-safe).
+  // Writes nothing: `dir` is created (if needed) by the first write(), so a run can build its outputs
+  // before it has validated everything. `fluid` selects the CSV rows (empty = all particles; must be
+  // thread-safe).
   FrameOutput(std::filesystem::path dir, OutputFormats formats, CsvRowFilter fluid = {},
               std::string pvd_name = "particles.pvd");
 
   // For --resume: reloads frames.csv and the .pvd and keeps the frames numbered below `next_frame`.
+  // Reads only; the kept index is written with the next frame.
   void resume(std::size_t next_frame);
 
   // Writes frame number `frame` at simulated time `time`; returns the files written (absolute). The
@@ -42,6 +45,7 @@ class FrameOutput {
   CsvRowFilter fluid_;
   FramesIndex index_;
   PvdWriter pvd_;
+  bool dir_made_ = false;
   Particles<Dim, Real> ordered_;     // the particles in id order, when they are not already
   std::vector<std::uint32_t> from_;  // index in the caller's particles of each of ordered_
 };

@@ -194,9 +194,9 @@ TEST(VtuWriter, ReplacesTargetAndLeavesNoTemporaryFile) {
   EXPECT_EQ(dir.listing(), std::vector<std::string>{"f.vtu"});
 }
 
-TEST(VtuWriter, UnwritableFolderIsAnInputError) {
+TEST(VtuWriter, UnwritableFolderIsAWriteError) {
   test::TempDir dir("vtu_bad");
-  EXPECT_THROW(write_vtu(test::make_particles<2, float>(3), 0.5, dir / "missing" / "f.vtu"), InputError);
+  EXPECT_THROW(write_vtu(test::make_particles<2, float>(3), 0.5, dir / "missing" / "f.vtu"), WriteError);
   EXPECT_TRUE(dir.listing().empty());
 }
 
