@@ -219,5 +219,28 @@ TEST(Scene, TooManyParticlesIsAnInputErrorBeforeAnyIsMade) {
   EXPECT_THROW((load_scene<3, float>(j, src)), InputError);
 }
 
+// SceneLimits::memory_bytes replaces the machine's memory in the count (the fuzz harness loads scenes on a
+// budget of a few MiB). kMinimal makes 10 x 5 = 50 particles; with the default support (2 spacings) and
+// skin (0.15) each has pi 2.3^2 = 16.6 pairs, 256 + 8 x 16.6 = 389 bytes by the cost model of
+// docs/scenes.md: 50 particles fit in 60 x 389 bytes, not in 40 x 389.
+TEST(Scene, MemoryLimitCapsTheParticles) {
+  const auto j = nlohmann::json::parse(kMinimal);
+  SceneLimits roomy, tight;
+  roomy.memory_bytes = 60 * 389;
+  tight.memory_bytes = 40 * 389;
+  EXPECT_EQ((load_scene<2, double>(j, "scene.json", roomy).particles.size()), 50u);
+  try {
+    load_scene<2, double>(j, "scene.json", tight);
+    FAIL() << "50 particles accepted in the memory of 40";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(
+        m.find("scene.json: /fluids: with the fluid blocks at spacing 0.1 m the scene has 50 particles, "
+               "more than 40 (what the allowed "),
+        std::string::npos)
+        << m;
+  }
+}
+
 }  // namespace
 }  // namespace cellsph
