@@ -6,7 +6,8 @@
 namespace cellsph {
 
 std::string json_value_text(const nlohmann::json& v) {
-  std::string s = v.dump();
+  // Invalid UTF-8 (only a --set value can hold it: apply_scene_edits refuses it) is shown replaced.
+  std::string s = v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   if (s.size() > 60) s = s.substr(0, 57) + "...";
   return s;
 }

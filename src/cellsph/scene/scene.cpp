@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <string_view>
 
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
@@ -36,10 +37,56 @@ nlohmann::json read_scene_json(const std::string& name_or_path, std::string& sou
   return JsonReader::parse_file(p);
 }
 
+namespace {
+
+// Offset of the first byte of `s` that is not part of well-formed UTF-8 (RFC 3629: no overlong forms,
+// no surrogates, nothing above U+10FFFF), or npos. A JSON string must be UTF-8: nlohmann's parser checks
+// the scene file, this the --set values that are taken as strings verbatim.
+std::size_t invalid_utf8_at(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // range of the second byte
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    if (c >= 0xC2 && c <= 0xDF) {
+      n = 1;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      n = 2;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      n = 3;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    } else {
+      return i;
+    }
+    if (s.size() - i <= n) return i;
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + k]);
+      if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return i;
+    }
+    i += n + 1;
+  }
+  return std::string_view::npos;
+}
+
+}  // namespace
+
 void apply_scene_edits(nlohmann::json& j, const std::vector<std::string>& edits, std::string& source) {
   if (edits.empty()) return;
   std::string list;
   for (const auto& e : edits) {
+    if (const auto bad = invalid_utf8_at(e); bad != std::string_view::npos) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(e[bad])));
+      throw InputError("--set: edit " + json_value_text(nlohmann::json(e.substr(0, bad))) +
+                       "... is not valid UTF-8 (byte " + hex + " at offset " + std::to_string(bad) + ")");
+    }
     const auto eq = e.find('=');
     if (eq == std::string::npos || eq == 1 || e[0] != '/')
       throw InputError("--set '" + e + "': expected /json/pointer=value, e.g. /phases/0/viscosity=1");

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/scene/scene.hpp"
@@ -194,6 +195,36 @@ TEST(Scene, BadEditsNameTheEdit) {
   apply_scene_edits(j, {"/spacng=0.05"}, src);
   const std::string err = load_error(j);
   EXPECT_NE(err.find("/spacng"), std::string::npos) << err;
+}
+
+// A --set value that is not JSON is taken as a string, and a JSON string must be UTF-8: a value with other
+// bytes once passed the edit and ended in "internal error" where it was printed or saved to run.json
+// (found by fuzz/scene_fuzz.cpp; the input is fuzz/regressions/scene/invalid-utf8-in-set-value). The
+// invalid sequences are the standard ones: a stray 0xFF, an overlong '/', a UTF-16 surrogate, a 2-byte
+// lead at the end.
+TEST(Scene, EditsThatAreNotUtf8AreRefusedWithTheOffset) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"/description=\xff", "byte 0xFF at offset 13"},
+      {"/description=a\xc0\xaf", "byte 0xC0 at offset 14"},
+      {"/neighbors={\"method\":\"\xed\xa0\x80\"}", "byte 0xED at offset 22"},
+      {"/name=x\xc3", "byte 0xC3 at offset 7"}};
+  for (const auto& [edit, where] : cases) {
+    auto j = nlohmann::json::parse(kMinimal);
+    std::string src = "scene.json";
+    try {
+      apply_scene_edits(j, {edit}, src);
+      FAIL() << "accepted " << edit;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is not valid UTF-8 (" + where + ")"), std::string::npos)
+          << e.what();
+    }
+  }
+  // Well-formed UTF-8 of 2, 3 and 4 bytes is a string like any other.
+  auto j = nlohmann::json::parse(kMinimal);
+  std::string src = "scene.json";
+  apply_scene_edits(j, {"/description=caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x8c\x8a"}, src);
+  EXPECT_EQ(j["description"], "caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x8c\x8a");
+  EXPECT_EQ(load_error(j), "");
 }
 
 // A spacing far too fine stops before any particle is made, naming the object that goes over and the
