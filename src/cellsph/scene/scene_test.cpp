@@ -159,6 +159,23 @@ TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
   std::filesystem::remove(path);
 }
 
+// A number beyond a double is valid JSON text that the parser cannot hold: it once ended in "internal
+// error" (nlohmann's out_of_range 406, not a parse_error); found by fuzz/scene_fuzz.cpp, input
+// fuzz/regressions/scene/number-beyond-double.
+TEST(Scene, NumberBeyondADoubleNamesFileLineAndColumn) {
+  const auto path = std::filesystem::temp_directory_path() / "cellsph_scene_overflow.json";
+  { std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 1e400\n}\n"; }
+  std::string src;
+  try {
+    read_scene_json(path.string(), src);
+    FAIL() << "1e400 accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + ":3:14: invalid JSON (number 1e400 is beyond the range of a double)");
+  }
+  std::filesystem::remove(path);
+}
+
 // --set edits: numbers, arrays and bare words land at their pointer; the edited scene loads.
 TEST(Scene, EditsSetValuesAtTheirPointers) {
   auto j = nlohmann::json::parse(kMinimal);
