@@ -976,6 +976,37 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
                        std::to_string(int(particles.kind[i])) + ", not in this scene's tables");
     }
   }
+  // Values no run holds (a checkpoint from another writer, or edited with its checksum fixed): refused
+  // here, where the step would meet them as an internal error or undefined behaviour (non-finite
+  // coordinates in the neighbour search, a shift by a level outside 0..max_level, ticks that overflow).
+  particles.for_each_field([&](std::string_view name, const auto& field) {
+    using T = typename std::remove_cvref_t<decltype(field)>::value_type;
+    for (std::size_t i = 0; i < field.size(); ++i) {
+      bool finite = true;
+      if constexpr (std::is_same_v<T, Real>) {
+        finite = std::isfinite(field[i]);
+      } else if constexpr (std::is_same_v<T, V>) {
+        for (int a = 0; a < Dim; ++a) finite = finite && std::isfinite(field[i][a]);
+      }
+      if (!finite)
+        throw InputError(source + ": particle " + std::to_string(i) + " has a non-finite " +
+                         std::string(name));
+    }
+  });
+  if (!(std::isfinite(state.time) && state.time >= 0 && std::isfinite(state.last_dt) && state.last_dt >= 0))
+    throw InputError(source + ": simulated time " + std::to_string(state.time) + " / last step " +
+                     std::to_string(state.last_dt) + " is not a finite number >= 0");
+  const std::int64_t max_tick = std::int64_t{1} << 62;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(particles.h[i] > 0))
+      throw InputError(source + ": particle " + std::to_string(i) + " has support " +
+                       std::to_string(particles.h[i]) + ", not > 0");
+    if (particles.level[i] < 0 || particles.level[i] > cfg_.time.max_level || particles.tick[i] < 0 ||
+        particles.tick[i] > max_tick)
+      throw InputError(source + ": particle " + std::to_string(i) + " has time-step level " +
+                       std::to_string(particles.level[i]) + " / tick " + std::to_string(particles.tick[i]) +
+                       ", outside 0.." + std::to_string(cfg_.time.max_level) + " / 0..2^62");
+  }
   p_ = std::move(particles);
   fluid_.clear();
   boundary_.clear();
