@@ -1018,8 +1018,16 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   }
   fluid_count_ = fluid_.size();
   lists_valid_ = false;
-  // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder).
-  if (cfg_.wall_model == WallModel::Dynamic) init_boundary_weights();
+  // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
+  // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
+  // the file's fault, named as such (the Simulation is then not usable; the caller stops).
+  if (cfg_.wall_model == WallModel::Dynamic) {
+    try {
+      init_boundary_weights();
+    } catch (const CapacityError& e) {
+      throw InputError(source + ": " + e.what());
+    }
+  }
   time_ = state.time;
   last_dt_ = state.last_dt;
   steps_ = state.steps;
