@@ -177,7 +177,14 @@ TEST(SimulationCheckpoint, ValuesNoRunHoldsAreRefusedNamingTheParticle) {
   EXPECT_EQ(error(p, st), "checkpoint 'c': particle 8 has a non-finite viscosity");
   p = good;
   p.h[2] = 0;
-  EXPECT_EQ(error(p, st), "checkpoint 'c': particle 2 has support 0.000000, not > 0");
+  EXPECT_EQ(error(p, st), "checkpoint 'c': particle 2 has support 0.000000, the scene's is 0.050000");
+  p = good;
+  for (auto& t : p.tick) t = 100;
+  p.tick[3] = 100 + 4096 + 1;  // more than 2^12 ticks (one dt_max) ahead of the others
+  EXPECT_EQ(error(p, st),
+            "checkpoint 'c': fluid particles' ticks span 100..4197, more than 2^12 (one largest step)");
+  p.tick[3] = 100 + 4096;
+  EXPECT_EQ(error(p, {0.5, 1e-3, 0, false}), "no error");
   p = good;
   p.level[1] = cfg.time.max_level + 1;
   EXPECT_NE(error(p, st).find("checkpoint 'c': particle 1 has time-step level 13 / tick 0, outside 0..12"),
@@ -188,7 +195,7 @@ TEST(SimulationCheckpoint, ValuesNoRunHoldsAreRefusedNamingTheParticle) {
   EXPECT_NE(error(good, {std::nan(""), 1e-3, 7, false}).find("simulated time nan"), std::string::npos);
   EXPECT_NE(error(good, {0.5, -1, 7, false}).find("last step -1.000000 is not a finite number >= 0"),
             std::string::npos);
-  EXPECT_EQ(sim.steps(), 0u) << "untouched on error";
+  EXPECT_EQ(sim.steps(), 0u) << "untouched on error (the one success above restored step 0)";
   EXPECT_EQ(error(good, st), "no error");
   EXPECT_EQ(sim.steps(), 7u);
 }

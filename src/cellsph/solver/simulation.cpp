@@ -996,17 +996,29 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   if (!(std::isfinite(state.time) && state.time >= 0 && std::isfinite(state.last_dt) && state.last_dt >= 0))
     throw InputError(source + ": simulated time " + std::to_string(state.time) + " / last step " +
                      std::to_string(state.last_dt) + " is not a finite number >= 0");
-  const std::int64_t max_tick = std::int64_t{1} << 62;
+  // Every particle's support is the scene's (set at construction, never changed), and per-particle steps
+  // keep every fluid particle's tick within 2^max_level of the earliest (a due particle moves at most
+  // dt_max ahead), so no step extrapolates a position further than dt_max.
+  const std::int64_t max_tick = std::int64_t{1} << 62, spread = std::int64_t{1} << cfg_.time.max_level;
+  std::int64_t lo_tick = max_tick, hi_tick = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!(particles.h[i] > 0))
+    if (particles.h[i] != cfg_.support)
       throw InputError(source + ": particle " + std::to_string(i) + " has support " +
-                       std::to_string(particles.h[i]) + ", not > 0");
+                       std::to_string(particles.h[i]) + ", the scene's is " + std::to_string(cfg_.support));
     if (particles.level[i] < 0 || particles.level[i] > cfg_.time.max_level || particles.tick[i] < 0 ||
         particles.tick[i] > max_tick)
       throw InputError(source + ": particle " + std::to_string(i) + " has time-step level " +
                        std::to_string(particles.level[i]) + " / tick " + std::to_string(particles.tick[i]) +
                        ", outside 0.." + std::to_string(cfg_.time.max_level) + " / 0..2^62");
+    if (particles.kind[i] == kFluid) {
+      lo_tick = std::min(lo_tick, particles.tick[i]);
+      hi_tick = std::max(hi_tick, particles.tick[i]);
+    }
   }
+  if (hi_tick > lo_tick && hi_tick - lo_tick > spread)
+    throw InputError(source + ": fluid particles' ticks span " + std::to_string(lo_tick) + ".." +
+                     std::to_string(hi_tick) + ", more than 2^" + std::to_string(cfg_.time.max_level) +
+                     " (one largest step)");
   p_ = std::move(particles);
   fluid_.clear();
   boundary_.clear();
