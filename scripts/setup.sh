@@ -6,8 +6,9 @@ PKGS=(g++ cmake ninja-build git pkg-config
       libgtest-dev libgmock-dev libbenchmark-dev
       libopenvdb-dev libboost-dev libboost-iostreams-dev)
 # With --test: what the tests use to check outputs with other people's tools (ffmpeg for the MP4,
-# VTK's own .vtu reader through Debian's python3-vtk9).
-if [ "${1:-}" = "--test" ]; then PKGS+=(ffmpeg python3-vtk9); fi
+# VTK's own .vtu reader through Debian's python3-vtk9), and clang with libFuzzer and its OpenMP for the
+# fuzz harnesses (scripts/fuzz.sh).
+if [ "${1:-}" = "--test" ]; then PKGS+=(ffmpeg python3-vtk9 clang libclang-rt-14-dev libomp-dev); fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
