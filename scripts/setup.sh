@@ -7,9 +7,12 @@ PKGS=(g++ cmake ninja-build git pkg-config
       libopenvdb-dev libboost-dev libboost-iostreams-dev
       python3-dev pybind11-dev python3-numpy)
 # With --test: what the tests use to check outputs with other people's tools (ffmpeg for the MP4,
-# VTK's own .vtu reader through Debian's python3-vtk9), and the Python module's tests (SciPy's cKDTree as
-# the reference search, pytest, matplotlib for the plot of docs/python.md's tour).
-if [ "${1:-}" = "--test" ]; then PKGS+=(ffmpeg python3-vtk9 python3-scipy python3-pytest python3-matplotlib); fi
+# VTK's own .vtu reader through Debian's python3-vtk9), the Python module's tests (SciPy's cKDTree as
+# the reference search, pytest, matplotlib for the plot of docs/python.md's tour), and clang with
+# libFuzzer and its OpenMP for the fuzz harnesses (scripts/fuzz.sh).
+if [ "${1:-}" = "--test" ]; then
+  PKGS+=(ffmpeg python3-vtk9 python3-scipy python3-pytest python3-matplotlib clang libclang-rt-14-dev libomp-dev)
+fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs what is needed, builds cellsph twice (release, and ASan+UBSan) and runs every test in both.
+# Installs what is needed, builds cellsph twice (release, and ASan+UBSan) and runs every test in both,
+# then fuzzes every reader for a short while (scripts/fuzz.sh, clang).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh --test
@@ -25,6 +26,9 @@ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLSPH_SA
 cmake --build build/asan -j "$JOBS"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/asan -j "$JOBS" --output-on-failure
+
+echo "== fuzzing: every reader for ${FUZZ_SECONDS:-45} s under libFuzzer + ASan + UBSan =="
+scripts/fuzz.sh "${FUZZ_SECONDS:-45}"
 
 echo "== the README's first command: the default scene =="
 scripts/run.sh

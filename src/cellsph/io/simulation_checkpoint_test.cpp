@@ -172,5 +172,53 @@ TEST(SimulationCheckpoint, MismatchesAreInputErrorsNamingTheFile) {
   EXPECT_NE(m.find((dir / "nothing.ckpt").string()), std::string::npos) << m;
 }
 
+// A checkpoint whose checksum is right can still hold values no run holds (written by another tool, or
+// edited and re-summed): a NaN position once passed restore() and stopped the first step with "internal
+// check failed" in the neighbour search (found by fuzz/checkpoint_fuzz.cpp, which re-sums its inputs); a
+// level outside 0..max_level would shift by a negative count. Each is refused, naming the particle.
+TEST(SimulationCheckpoint, ValuesNoRunHoldsAreRefusedNamingTheParticle) {
+  const auto cfg = config<2, double>(Model::Wcsph);
+  Simulation<2, double> sim(cfg, block<2, double>(3));
+  const auto good = sim.particles();
+  const IntegratorState<double> st{0.5, 1e-3, 7, false};
+  auto error = [&](const Particles<2, double>& p, const IntegratorState<double>& s) -> std::string {
+    try {
+      sim.restore(p, s, "checkpoint 'c'");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  auto p = good;
+  p.x[4][1] = std::nan("");
+  EXPECT_EQ(error(p, st), "checkpoint 'c': particle 4 has a non-finite position");
+  p = good;
+  p.mu[8] = -HUGE_VAL;
+  EXPECT_EQ(error(p, st), "checkpoint 'c': particle 8 has a non-finite viscosity");
+  p = good;
+  p.h[2] = 0;
+  EXPECT_EQ(error(p, st), "checkpoint 'c': particle 2 has support 0.000000, the scene's is 0.050000");
+  p = good;
+  for (auto& t : p.tick) t = 100;
+  p.tick[3] = 100 + 4096 + 1;  // more than 2^12 ticks (one dt_max) ahead of the others
+  EXPECT_EQ(error(p, st),
+            "checkpoint 'c': fluid particles' ticks span 100..4197, more than 2^12 (one largest step)");
+  p.tick[3] = 100 + 4096;
+  EXPECT_EQ(error(p, {0.5, 1e-3, 0, false}), "no error");
+  p = good;
+  p.level[1] = cfg.time.max_level + 1;
+  EXPECT_NE(error(p, st).find("checkpoint 'c': particle 1 has time-step level 13 / tick 0, outside 0..12"),
+            std::string::npos);
+  p = good;
+  p.tick[0] = -1;
+  EXPECT_NE(error(p, st).find("particle 0 has time-step level 0 / tick -1"), std::string::npos);
+  EXPECT_NE(error(good, {std::nan(""), 1e-3, 7, false}).find("simulated time nan"), std::string::npos);
+  EXPECT_NE(error(good, {0.5, -1, 7, false}).find("last step -1.000000 is not a finite number >= 0"),
+            std::string::npos);
+  EXPECT_EQ(sim.steps(), 0u) << "untouched on error (the one success above restored step 0)";
+  EXPECT_EQ(error(good, st), "no error");
+  EXPECT_EQ(sim.steps(), 7u);
+}
+
 }  // namespace
 }  // namespace cellsph

@@ -6,10 +6,29 @@
 namespace cellsph {
 
 std::string json_value_text(const nlohmann::json& v) {
-  std::string s = v.dump();
+  // Invalid UTF-8 (only a --set value can hold it: apply_scene_edits refuses it) is shown replaced.
+  std::string s = v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   if (s.size() > 60) s = s.substr(0, 57) + "...";
   return s;
 }
+
+namespace {
+
+// "FILE:LINE:COLUMN" of the byte at `offset` (0-based) of `text`.
+std::string where_in(const std::filesystem::path& file, const std::string& text, std::size_t offset) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t k = 0; k < offset && k < text.size(); ++k) {
+    if (text[k] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return file.string() + ":" + std::to_string(line) + ":" + std::to_string(col);
+}
+
+}  // namespace
 
 nlohmann::json JsonReader::parse_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -20,18 +39,18 @@ nlohmann::json JsonReader::parse_file(const std::filesystem::path& file) {
   try {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    // Translate the byte offset into a line and column.
-    std::size_t line = 1, col = 1;
-    for (std::size_t k = 0; k + 1 < e.byte && k < text.size(); ++k) {
-      if (text[k] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    throw InputError(file.string() + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                     ": invalid JSON (" + std::string(e.what()) + ")");
+    // e.byte: 1-based offset of the byte after the error.
+    throw InputError(where_in(file, text, e.byte > 0 ? e.byte - 1 : 0) + ": invalid JSON (" +
+                     std::string(e.what()) + ")");
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond a double (1e400): the message quotes it; name where it first appears.
+    std::string what = e.what(), number;
+    const auto q0 = what.find('\''), q1 = what.rfind('\'');
+    if (q0 != std::string::npos && q1 > q0) number = what.substr(q0 + 1, q1 - q0 - 1);
+    const auto at = number.empty() ? std::string::npos : text.find(number);
+    throw InputError((at == std::string::npos ? file.string() : where_in(file, text, at)) +
+                     ": invalid JSON (" +
+                     (number.empty() ? what : "number " + number + " is beyond the range of a double") + ")");
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <string_view>
 
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
@@ -36,10 +37,56 @@ nlohmann::json read_scene_json(const std::string& name_or_path, std::string& sou
   return JsonReader::parse_file(p);
 }
 
+namespace {
+
+// Offset of the first byte of `s` that is not part of well-formed UTF-8 (RFC 3629: no overlong forms,
+// no surrogates, nothing above U+10FFFF), or npos. A JSON string must be UTF-8: nlohmann's parser checks
+// the scene file, this the --set values that are taken as strings verbatim.
+std::size_t invalid_utf8_at(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // range of the second byte
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    if (c >= 0xC2 && c <= 0xDF) {
+      n = 1;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      n = 2;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      n = 3;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    } else {
+      return i;
+    }
+    if (s.size() - i <= n) return i;
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + k]);
+      if (k == 1 ? (b < lo || b > hi) : (b < 0x80 || b > 0xBF)) return i;
+    }
+    i += n + 1;
+  }
+  return std::string_view::npos;
+}
+
+}  // namespace
+
 void apply_scene_edits(nlohmann::json& j, const std::vector<std::string>& edits, std::string& source) {
   if (edits.empty()) return;
   std::string list;
   for (const auto& e : edits) {
+    if (const auto bad = invalid_utf8_at(e); bad != std::string_view::npos) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(e[bad])));
+      throw InputError("--set: edit " + json_value_text(nlohmann::json(e.substr(0, bad))) +
+                       "... is not valid UTF-8 (byte " + hex + " at offset " + std::to_string(bad) + ")");
+    }
     const auto eq = e.find('=');
     if (eq == std::string::npos || eq == 1 || e[0] != '/')
       throw InputError("--set '" + e + "': expected /json/pointer=value, e.g. /phases/0/viscosity=1");
@@ -207,15 +254,21 @@ double bytes_per_particle(double pairs) {
 class ParticleBudget {
  public:
   // `radius`: the search radius h (1 + skin) in spacings, which sets the pairs each particle keeps.
-  ParticleBudget(int dim, double spacing, double radius) : spacing_(spacing) {
+  // `memory`: the bytes the particles may take (SceneLimits), 0 for this machine's memory.
+  ParticleBudget(int dim, double spacing, double radius, double memory) : spacing_(spacing) {
     limit_ = double(std::size_t{1} << 31);
     why_ = "2^31, the most particles a run can index";
     const double pairs = pairs_per_particle(dim, radius), bytes = bytes_per_particle(pairs);
-    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    const double memory = double(pages) * double(page);
-    if (pages > 0 && page > 0 && memory / bytes < limit_) {
+    std::string whose = "this machine's";
+    if (memory > 0) {
+      whose = "the allowed";
+    } else {
+      const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+      memory = pages > 0 && page > 0 ? double(pages) * double(page) : 0;
+    }
+    if (memory > 0 && memory / bytes < limit_) {
       limit_ = memory / bytes;
-      why_ = "what this machine's " + number(memory / double(1L << 30)) + " GiB of memory hold at about " +
+      why_ = "what " + whose + " " + number(memory / double(1L << 30)) + " GiB of memory hold at about " +
              number(bytes) + " bytes a particle, which has " + number(pairs) + " neighbours within " +
              number(radius) + " spacings";
     }
@@ -250,273 +303,322 @@ std::array<long, 3> cells_of(const Aabb<Dim>& b, double spacing) {
   return n;
 }
 
-}  // namespace
+// Each function below reads one section of docs/scenes.md from the top-level reader `r`: it owns the
+// section's keys, their defaults and their errors. load_scene calls them in the order in which their
+// errors are reported (a section may use what the earlier ones set: the time section checks the model,
+// the walls the first phase's density and gravity).
 
-template <int Dim, class Real>
-Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) {
-  Scene<Dim, Real> s;
-  s.header = read_scene_header(j, source);
-  s.source = source;
-  CELLSPH_CHECK(s.header.dim == Dim, "scene dimension " << s.header.dim << " loaded as " << Dim);
-  JsonReader r(j, source, "");
-  // The header keys were checked by read_scene_header; mark them read here.
-  r.string("name", "");
-  r.string("description", "");
-  r.integer("dimension", 2, 2, 3);
-  r.string("precision", "");
-
-  const double spacing = r.required_number("spacing", 1e-9, 1e9);
-  s.spacing = static_cast<Real>(spacing);
-  auto& cfg = s.solver;
-
-  // --- phases ---------------------------------------------------------------------------------
-  std::vector<std::string> phase_names;
+// --- phases (/phases) ---------------------------------------------------------------------------
+// What the later sections need from the phases.
+struct PhaseTable {
+  std::vector<std::string> names;
   std::vector<bool> mass_given;  // phases[k].mass set by the scene
-  if (r.has("phases")) {
-    cfg.phases.clear();
-    auto pr = r.child("phases");
-    const std::size_t np = pr.array_size();
-    if (np == 0) pr.fail_here("at least one phase is needed");
-    for (std::size_t k = 0; k < np; ++k) {
-      auto e = pr.element(k);
-      if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
-      Phase<Real> ph;
-      ph.name = e.string("name", "phase" + std::to_string(k));
-      ph.rest_density = static_cast<Real>(e.number("rest_density", 1000, 1e-6, 1e9));
-      ph.mass = static_cast<Real>(e.number("mass", 0, 0, 1e12));
-      ph.viscosity = static_cast<Real>(e.number("viscosity", 0, 0, 1e9));
-      ph.color = static_cast<Real>(e.number("color", 1, -1e9, 1e9));
-      ph.sigma = static_cast<Real>(e.number("sigma", 0, 0, 1e9));
-      e.finish();
-      mass_given.push_back(ph.mass != 0);
-      if (ph.mass == 0) ph.mass = ph.rest_density * static_cast<Real>(std::pow(spacing, Dim));
-      phase_names.push_back(ph.name);
-      cfg.phases.push_back(ph);
-    }
-  } else {
-    cfg.phases[0].mass = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
-    phase_names.push_back(cfg.phases[0].name);
-    mass_given.push_back(false);
-  }
-  auto read_phase = [&](JsonReader& e) -> std::int32_t {
+
+  // The "phase" key of a fluid block: an index or a name of a phase; 0 when absent.
+  std::int32_t read_reference(JsonReader& e) const {
     if (!e.has("phase")) return 0;
     const auto& v = e.json()["phase"];
     if (v.is_string()) {
       const std::string name = e.string("phase", "");
-      for (std::size_t k = 0; k < phase_names.size(); ++k)
-        if (phase_names[k] == name) return static_cast<std::int32_t>(k);
+      for (std::size_t k = 0; k < names.size(); ++k)
+        if (names[k] == name) return static_cast<std::int32_t>(k);
       e.fail("phase", "no phase named \"" + name + "\"");
     }
-    return static_cast<std::int32_t>(e.integer("phase", 0, 0, static_cast<long>(phase_names.size()) - 1));
-  };
+    return static_cast<std::int32_t>(e.integer("phase", 0, 0, static_cast<long>(names.size()) - 1));
+  }
+};
 
-  // --- solver ---------------------------------------------------------------------------------
+template <int Dim, class Real>
+PhaseTable read_phases(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
+  PhaseTable t;
+  if (!r.has("phases")) {
+    cfg.phases[0].mass = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
+    t.names.push_back(cfg.phases[0].name);
+    t.mass_given.push_back(false);
+    return t;
+  }
+  cfg.phases.clear();
+  auto pr = r.child("phases");
+  const std::size_t np = pr.array_size();
+  if (np == 0) pr.fail_here("at least one phase is needed");
+  for (std::size_t k = 0; k < np; ++k) {
+    auto e = pr.element(k);
+    if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+    Phase<Real> ph;
+    ph.name = e.string("name", "phase" + std::to_string(k));
+    ph.rest_density = static_cast<Real>(e.number("rest_density", 1000, 1e-6, 1e9));
+    ph.mass = static_cast<Real>(e.number("mass", 0, 0, 1e12));
+    ph.viscosity = static_cast<Real>(e.number("viscosity", 0, 0, 1e9));
+    ph.color = static_cast<Real>(e.number("color", 1, -1e9, 1e9));
+    ph.sigma = static_cast<Real>(e.number("sigma", 0, 0, 1e9));
+    e.finish();
+    t.mass_given.push_back(ph.mass != 0);
+    if (ph.mass == 0) ph.mass = ph.rest_density * static_cast<Real>(std::pow(spacing, Dim));
+    t.names.push_back(ph.name);
+    cfg.phases.push_back(ph);
+  }
+  return t;
+}
+
+// --- solver (/solver, with /solver/eos) --------------------------------------------------------------
+template <class Real>
+void read_eos(JsonReader& sr, EquationOfState<Real>& eos) {
+  if (!sr.has("eos")) return;
+  auto er = sr.child("eos");
+  eos.kind = *parse_eos(er.choice("kind", "tait", {"tait", "linear", "ratio", "seventh"}));
+  eos.stiffness = static_cast<Real>(er.number("stiffness", double(eos.stiffness), 1e-12, 1e15));
+  eos.gamma = static_cast<Real>(er.number("gamma", double(eos.gamma), 1e-3, 100));
+  eos.clamp_negative = er.boolean("clamp_negative", eos.clamp_negative);
+  er.finish();
+}
+
+template <int Dim, class Real>
+void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   cfg.support = static_cast<Real>(2 * spacing);
-  if (r.has("solver")) {
-    auto sr = r.child("solver");
-    cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph"}));
-    cfg.support = static_cast<Real>(sr.number("support", 2 * spacing, 1e-9, 1e9));
-    if (cfg.support < static_cast<Real>(spacing))
-      sr.fail("support", "value " + std::to_string(cfg.support) + " is smaller than the particle spacing " +
-                             std::to_string(spacing) + ": particles would have no neighbours");
-    std::vector<std::string> kernels;
-    for (KernelKind k : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity, KernelKind::CubicSpline,
-                         KernelKind::WendlandC2})
-      kernels.emplace_back(kernel_name(k));
-    cfg.density_kernel = *parse_kernel(sr.choice("density_kernel", "poly6", kernels));
-    cfg.pressure_kernel = *parse_kernel(sr.choice("pressure_kernel", "spiky", kernels));
-    cfg.density = *parse_density_formulation(sr.choice("density", "mass", {"mass", "number"}));
-    if (sr.has("eos")) {
-      auto er = sr.child("eos");
-      cfg.eos.kind = *parse_eos(er.choice("kind", "tait", {"tait", "linear", "ratio", "seventh"}));
-      cfg.eos.stiffness = static_cast<Real>(er.number("stiffness", double(cfg.eos.stiffness), 1e-12, 1e15));
-      cfg.eos.gamma = static_cast<Real>(er.number("gamma", double(cfg.eos.gamma), 1e-3, 100));
-      cfg.eos.clamp_negative = er.boolean("clamp_negative", cfg.eos.clamp_negative);
-      er.finish();
-    }
-    if (sr.has("gravity")) {
-      const auto g = sr.vector("gravity", Dim, {});
-      for (double c : g)
-        if (!(std::abs(c) <= 1e9))
-          sr.fail("gravity", "component " + json_value_text(c) + " is beyond 1e9 m/s^2");
-      cfg.gravity = to_vec<Dim, Real>(g);
-    }
-    cfg.tension_threshold = static_cast<Real>(sr.number("tension_threshold", 0, 0, 1e12));
-    cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf", "akinci"}));
-    cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
-    cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
-    sr.finish();
-  } else {
+  if (!r.has("solver")) {
     cfg.model = Model::Wcsph;
+    return;
   }
+  auto sr = r.child("solver");
+  cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph"}));
+  cfg.support = static_cast<Real>(sr.number("support", 2 * spacing, 1e-9, 1e9));
+  if (cfg.support < static_cast<Real>(spacing))
+    sr.fail("support", "value " + std::to_string(cfg.support) + " is smaller than the particle spacing " +
+                           std::to_string(spacing) + ": particles would have no neighbours");
+  std::vector<std::string> kernels;
+  for (KernelKind k : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity, KernelKind::CubicSpline,
+                       KernelKind::WendlandC2})
+    kernels.emplace_back(kernel_name(k));
+  cfg.density_kernel = *parse_kernel(sr.choice("density_kernel", "poly6", kernels));
+  cfg.pressure_kernel = *parse_kernel(sr.choice("pressure_kernel", "spiky", kernels));
+  cfg.density = *parse_density_formulation(sr.choice("density", "mass", {"mass", "number"}));
+  read_eos(sr, cfg.eos);
+  if (sr.has("gravity")) {
+    const auto g = sr.vector("gravity", Dim, {});
+    for (double c : g)
+      if (!(std::abs(c) <= 1e9))
+        sr.fail("gravity", "component " + json_value_text(c) + " is beyond 1e9 m/s^2");
+    cfg.gravity = to_vec<Dim, Real>(g);
+  }
+  cfg.tension_threshold = static_cast<Real>(sr.number("tension_threshold", 0, 0, 1e12));
+  cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf", "akinci"}));
+  cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
+  cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
+  sr.finish();
+}
 
-  // --- time -----------------------------------------------------------------------------------
-  if (r.has("time")) {
-    auto tr = r.child("time");
-    s.output.end_time = tr.number("end", s.output.end_time, 1e-12, 1e9);
-    cfg.time.mode =
-        *parse_time_stepping(tr.choice("stepping", "courant", {"fixed", "courant", "per-particle"}));
-    if (cfg.time.mode == TimeStepping::PerParticle && cfg.model != Model::PaperMultiphase)
-      tr.fail("stepping", "\"per-particle\" needs the paper model (/solver/model = \"paper\")");
-    cfg.time.max_level = static_cast<int>(tr.integer("max_level", cfg.time.max_level, 0, 30));
-    cfg.time.correction = *parse_correction(tr.choice("correction", "exact", {"exact", "printed"}));
-    cfg.time.dt = static_cast<Real>(tr.number("dt", double(cfg.time.dt), 1e-12, 10));
-    cfg.time.dt_max = static_cast<Real>(tr.number("dt_max", double(cfg.time.dt_max), 1e-12, 10));
-    cfg.time.courant = static_cast<Real>(tr.number("courant", double(cfg.time.courant), 1e-6, 2));
-    cfg.time.viscous = static_cast<Real>(tr.number("viscous", double(cfg.time.viscous), 1e-6, 10));
-    cfg.time.force = static_cast<Real>(tr.number("force", double(cfg.time.force), 1e-6, 10));
-    tr.finish();
-  } else {
+// --- time (/time; after the solver: per-particle steps need the paper model) -------------------------
+template <int Dim, class Real>
+void read_time(JsonReader& r, SolverConfig<Dim, Real>& cfg, OutputSettings& out) {
+  if (!r.has("time")) {
     cfg.time.mode = TimeStepping::Courant;
+    return;
   }
+  auto tr = r.child("time");
+  out.end_time = tr.number("end", out.end_time, 1e-12, 1e9);
+  cfg.time.mode =
+      *parse_time_stepping(tr.choice("stepping", "courant", {"fixed", "courant", "per-particle"}));
+  if (cfg.time.mode == TimeStepping::PerParticle && cfg.model != Model::PaperMultiphase)
+    tr.fail("stepping", "\"per-particle\" needs the paper model (/solver/model = \"paper\")");
+  cfg.time.max_level = static_cast<int>(tr.integer("max_level", cfg.time.max_level, 0, 30));
+  cfg.time.correction = *parse_correction(tr.choice("correction", "exact", {"exact", "printed"}));
+  cfg.time.dt = static_cast<Real>(tr.number("dt", double(cfg.time.dt), 1e-12, 10));
+  cfg.time.dt_max = static_cast<Real>(tr.number("dt_max", double(cfg.time.dt_max), 1e-12, 10));
+  cfg.time.courant = static_cast<Real>(tr.number("courant", double(cfg.time.courant), 1e-6, 2));
+  cfg.time.viscous = static_cast<Real>(tr.number("viscous", double(cfg.time.viscous), 1e-6, 10));
+  cfg.time.force = static_cast<Real>(tr.number("force", double(cfg.time.force), 1e-6, 10));
+  tr.finish();
+}
 
-  // --- neighbour search -----------------------------------------------------------------------
-  if (r.has("neighbors")) {
-    auto nr = r.child("neighbors");
-    std::vector<std::string> methods;
-    for (Method m : kAllMethods) methods.emplace_back(method_name(m));
-    cfg.search.method = *parse_method(nr.choice("method", "cell-index", methods));
-    cfg.search.subdivision = static_cast<int>(nr.integer("subdivision", 1, 1, 16));
-    cfg.search.hash_table_size = static_cast<std::size_t>(nr.integer("hash_table_size", 0, 0, 4294967294L));
-    cfg.verlet_skin = static_cast<Real>(nr.number("skin", double(cfg.verlet_skin), 0, 1));
-    cfg.reorder_every = static_cast<std::uint32_t>(
-        nr.integer("reorder_every", static_cast<long>(cfg.reorder_every), 0, 1000000));
-    nr.finish();
-  }
+// --- neighbour search (/neighbors) --------------------------------------------------------------
+template <int Dim, class Real>
+void read_neighbors(JsonReader& r, SolverConfig<Dim, Real>& cfg) {
+  if (!r.has("neighbors")) return;
+  auto nr = r.child("neighbors");
+  std::vector<std::string> methods;
+  for (Method m : kAllMethods) methods.emplace_back(method_name(m));
+  cfg.search.method = *parse_method(nr.choice("method", "cell-index", methods));
+  cfg.search.subdivision = static_cast<int>(nr.integer("subdivision", 1, 1, 16));
+  cfg.search.hash_table_size = static_cast<std::size_t>(nr.integer("hash_table_size", 0, 0, 4294967294L));
+  cfg.verlet_skin = static_cast<Real>(nr.number("skin", double(cfg.verlet_skin), 0, 1));
+  cfg.reorder_every = static_cast<std::uint32_t>(
+      nr.integer("reorder_every", static_cast<long>(cfg.reorder_every), 0, 1000000));
+  nr.finish();
+}
 
-  // --- boundary -------------------------------------------------------------------------------
-  ParticleBudget budget(Dim, spacing, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing);
-  // The fluid blocks first (they are most of a scene, and are made last): counted from the JSON as it
-  // is; a malformed block counts 0 here and is reported by the strict reading below.
-  {
-    double fluid = 0;
-    if (j.contains("fluids") && j["fluids"].is_array())
-      for (const auto& b : j["fluids"]) {
-        if (!b.is_object() || !b.contains("min") || !b.contains("max")) continue;
-        const auto &lo = b["min"], &hi = b["max"];
-        if (!lo.is_array() || !hi.is_array() || lo.size() != Dim || hi.size() != Dim) continue;
-        double n = 1;
-        for (std::size_t a = 0; a < Dim; ++a)
-          if (lo[a].is_number() && hi[a].is_number())
-            n *= std::max(0.0, std::round((hi[a].get<double>() - lo[a].get<double>()) / spacing));
-        fluid += n;
-      }
-    budget.take(fluid, r, "fluids", "the fluid blocks");
-  }
+// --- boundary (/boundary) and domain (/domain) --------------------------------------------------
+// The regions the fluid blocks are checked against.
+template <int Dim>
+struct Regions {
   std::vector<Aabb<Dim>> solids;       // regions fluid must not overlap
   std::optional<Aabb<Dim>> container;  // region fluid must lie in
-  auto& p = s.particles;
-  if (r.has("boundary")) {
-    auto br = r.child("boundary");
-    cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
-    cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic"}));
-    if (br.has("box")) {
-      auto bx = br.child("box");
-      const auto b = read_box<Dim>(bx);
-      cfg.box.enabled = true;
-      cfg.box.lo = to_vec<Dim, Real>(b.lo);
-      cfg.box.hi = to_vec<Dim, Real>(b.hi);
-      cfg.box.damping = static_cast<Real>(bx.number("damping", double(cfg.box.damping), -1, 0));
-      cfg.box.radius = static_cast<Real>(bx.number("radius", spacing / 2, 0, 1e9));
-      bx.finish();
-      container = b;
-    }
-    if (br.has("planes")) {
-      auto pl = br.child("planes");
-      for (std::size_t k = 0; k < pl.array_size(); ++k) {
-        auto e = pl.element(k);
-        auto n = e.required_vector("normal", Dim);
-        const auto pt = e.required_vector("point", Dim);
-        double len = 0;
-        for (double c : n) len += c * c;
-        len = std::sqrt(len);
-        if (!(len > 0)) e.fail("normal", "must not be the zero vector");
-        Plane<Dim, Real> plane;
-        double off = 0;
-        for (int a = 0; a < Dim; ++a) {
-          plane.normal[a] = static_cast<Real>(n[static_cast<std::size_t>(a)] / len);
-          off += n[static_cast<std::size_t>(a)] / len * pt[static_cast<std::size_t>(a)];
-        }
-        plane.offset = static_cast<Real>(off);
-        cfg.planes.push_back(plane);
-        e.finish();
-      }
-    }
-    if (br.has("walls")) {
-      auto wr = br.child("walls");
-      const auto b = read_box<Dim>(wr);
-      const int layers = static_cast<int>(wr.integer("layers", 3, 1, 10));
-      const bool open_top = wr.boolean("open_top", true);
-      // "akinci": the Simulation computes each wall particle's psi_b (Akinci 2012); "volume":
-      // rest_density * spacing^dim, right when the wall is at least one support length thick.
-      const bool volume = wr.choice("weight", "akinci", {"akinci", "volume"}) == "volume";
-      wr.finish();
-      const Real weight =
-          volume ? cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim)) : Real(0);
-      // At most the (n + 2 layers)^Dim lattice around the box minus its inside (an open top has fewer).
-      double outer = 1, inner = 1;
-      for (std::size_t a = 0; a < Dim; ++a) {
-        const double n = std::round((b.hi[a] - b.lo[a]) / spacing);
-        outer *= n + 2 * layers;
-        inner *= n;
-      }
-      budget.take(outer - inner, br, "walls", "the walls");
-      // The open face is the top as gravity sees it (scenes with y up in 3D), not always the last axis.
-      int up = Dim - 1;
-      for (int a = 0; a < Dim; ++a)
-        if (std::abs(cfg.gravity[a]) > std::abs(cfg.gravity[up])) up = a;
-      add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
-                    open_top, 0, weight, up);
-      container = b;
-    }
-    if (br.has("obstacles")) {
-      auto ob = br.child("obstacles");
-      for (std::size_t k = 0; k < ob.array_size(); ++k) {
-        auto e = ob.element(k);
-        const auto b = read_box<Dim>(e);
-        e.finish();
-        const auto n = cells_of<Dim>(b, spacing);
-        for (std::size_t a = 0; a < Dim; ++a)
-          if (n[a] < 1) e.fail("max", "obstacle is thinner than one particle spacing");
-        budget.take(double(n[0]) * double(n[1]) * double(n[2]), ob, std::to_string(k), "this obstacle");
-        // A solid block of static boundary particles.
-        for (long kk = 0; kk < n[2]; ++kk)
-          for (long jj = 0; jj < n[1]; ++jj)
-            for (long ii = 0; ii < n[0]; ++ii) {
-              const long idx[3] = {ii, jj, kk};
-              Vec<Dim, Real> x;
-              for (std::size_t a = 0; a < Dim; ++a)
-                x[static_cast<int>(a)] = static_cast<Real>(b.lo[a] + (double(idx[a]) + 0.5) * spacing);
-              add_particle(p, x, 0, ParticleKind::Boundary);
-            }
-        solids.push_back(b);
-      }
-    }
-    br.finish();
-  }
-  if (r.has("domain")) {
-    auto dr = r.child("domain");
-    const auto b = read_box<Dim>(dr);
-    dr.finish();
-    cfg.domain_set = true;
-    cfg.domain_lo = to_vec<Dim, Real>(b.lo);
-    cfg.domain_hi = to_vec<Dim, Real>(b.hi);
-    if (!container) container = b;
-  }
+};
 
-  // --- fluid blocks ---------------------------------------------------------------------------
+template <int Dim, class Real>
+void read_box_boundary(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regions) {
+  if (!br.has("box")) return;
+  auto bx = br.child("box");
+  const auto b = read_box<Dim>(bx);
+  cfg.box.enabled = true;
+  cfg.box.lo = to_vec<Dim, Real>(b.lo);
+  cfg.box.hi = to_vec<Dim, Real>(b.hi);
+  cfg.box.damping = static_cast<Real>(bx.number("damping", double(cfg.box.damping), -1, 0));
+  cfg.box.radius = static_cast<Real>(bx.number("radius", spacing / 2, 0, 1e9));
+  bx.finish();
+  regions.container = b;
+}
+
+template <int Dim, class Real>
+void read_planes(JsonReader& br, SolverConfig<Dim, Real>& cfg) {
+  if (!br.has("planes")) return;
+  auto pl = br.child("planes");
+  for (std::size_t k = 0; k < pl.array_size(); ++k) {
+    auto e = pl.element(k);
+    auto n = e.required_vector("normal", Dim);
+    const auto pt = e.required_vector("point", Dim);
+    double len = 0;
+    for (double c : n) len += c * c;
+    len = std::sqrt(len);
+    if (!(len > 0)) e.fail("normal", "must not be the zero vector");
+    Plane<Dim, Real> plane;
+    double off = 0;
+    for (int a = 0; a < Dim; ++a) {
+      plane.normal[a] = static_cast<Real>(n[static_cast<std::size_t>(a)] / len);
+      off += n[static_cast<std::size_t>(a)] / len * pt[static_cast<std::size_t>(a)];
+    }
+    plane.offset = static_cast<Real>(off);
+    cfg.planes.push_back(plane);
+    e.finish();
+  }
+}
+
+template <int Dim, class Real>
+void read_walls(JsonReader& br, double spacing, const SolverConfig<Dim, Real>& cfg, ParticleBudget& budget,
+                Particles<Dim, Real>& p, Regions<Dim>& regions) {
+  if (!br.has("walls")) return;
+  auto wr = br.child("walls");
+  const auto b = read_box<Dim>(wr);
+  const int layers = static_cast<int>(wr.integer("layers", 3, 1, 10));
+  const bool open_top = wr.boolean("open_top", true);
+  // "akinci": the Simulation computes each wall particle's psi_b (Akinci 2012); "volume":
+  // rest_density * spacing^dim, right when the wall is at least one support length thick.
+  const bool volume = wr.choice("weight", "akinci", {"akinci", "volume"}) == "volume";
+  wr.finish();
+  const Real weight =
+      volume ? cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim)) : Real(0);
+  // At most the (n + 2 layers)^Dim lattice around the box minus its inside (an open top has fewer).
+  double outer = 1, inner = 1;
+  for (std::size_t a = 0; a < Dim; ++a) {
+    const double n = std::round((b.hi[a] - b.lo[a]) / spacing);
+    outer *= n + 2 * layers;
+    inner *= n;
+  }
+  budget.take(outer - inner, br, "walls", "the walls");
+  // The open face is the top as gravity sees it (scenes with y up in 3D), not always the last axis.
+  int up = Dim - 1;
+  for (int a = 0; a < Dim; ++a)
+    if (std::abs(cfg.gravity[a]) > std::abs(cfg.gravity[up])) up = a;
+  add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
+                open_top, 0, weight, up);
+  regions.container = b;
+}
+
+template <int Dim, class Real>
+void read_obstacles(JsonReader& br, double spacing, ParticleBudget& budget, Particles<Dim, Real>& p,
+                    Regions<Dim>& regions) {
+  if (!br.has("obstacles")) return;
+  auto ob = br.child("obstacles");
+  for (std::size_t k = 0; k < ob.array_size(); ++k) {
+    auto e = ob.element(k);
+    const auto b = read_box<Dim>(e);
+    e.finish();
+    const auto n = cells_of<Dim>(b, spacing);
+    for (std::size_t a = 0; a < Dim; ++a)
+      if (n[a] < 1) e.fail("max", "obstacle is thinner than one particle spacing");
+    budget.take(double(n[0]) * double(n[1]) * double(n[2]), ob, std::to_string(k), "this obstacle");
+    // A solid block of static boundary particles.
+    for (long kk = 0; kk < n[2]; ++kk)
+      for (long jj = 0; jj < n[1]; ++jj)
+        for (long ii = 0; ii < n[0]; ++ii) {
+          const long idx[3] = {ii, jj, kk};
+          Vec<Dim, Real> x;
+          for (std::size_t a = 0; a < Dim; ++a)
+            x[static_cast<int>(a)] = static_cast<Real>(b.lo[a] + (double(idx[a]) + 0.5) * spacing);
+          add_particle(p, x, 0, ParticleKind::Boundary);
+        }
+    regions.solids.push_back(b);
+  }
+}
+
+// Makes the wall and obstacle particles (after the fluid blocks were counted, before they are made).
+template <int Dim, class Real>
+Regions<Dim> read_boundary(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg,
+                           ParticleBudget& budget, Particles<Dim, Real>& p) {
+  Regions<Dim> regions;
+  if (!r.has("boundary")) return regions;
+  auto br = r.child("boundary");
+  cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
+  cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic"}));
+  read_box_boundary(br, spacing, cfg, regions);
+  read_planes(br, cfg);
+  read_walls(br, spacing, cfg, budget, p, regions);
+  read_obstacles(br, spacing, budget, p, regions);
+  br.finish();
+  return regions;
+}
+
+template <int Dim, class Real>
+void read_domain(JsonReader& r, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regions) {
+  if (!r.has("domain")) return;
+  auto dr = r.child("domain");
+  const auto b = read_box<Dim>(dr);
+  dr.finish();
+  cfg.domain_set = true;
+  cfg.domain_lo = to_vec<Dim, Real>(b.lo);
+  cfg.domain_hi = to_vec<Dim, Real>(b.hi);
+  if (!regions.container) regions.container = b;
+}
+
+// --- fluid blocks (/fluids, /initial_pressure) --------------------------------------------------
+// The particles the fluid blocks ask for, counted from the JSON as it is (before the boundary, as they are
+// most of a scene); a malformed block counts 0 here and is reported by read_fluids.
+template <int Dim>
+double count_fluid_particles(const nlohmann::json& j, double spacing) {
+  double fluid = 0;
+  if (j.contains("fluids") && j["fluids"].is_array())
+    for (const auto& b : j["fluids"]) {
+      if (!b.is_object() || !b.contains("min") || !b.contains("max")) continue;
+      const auto &lo = b["min"], &hi = b["max"];
+      if (!lo.is_array() || !hi.is_array() || lo.size() != Dim || hi.size() != Dim) continue;
+      double n = 1;
+      for (std::size_t a = 0; a < Dim; ++a)
+        if (lo[a].is_number() && hi[a].is_number())
+          n *= std::max(0.0, std::round((hi[a].get<double>() - lo[a].get<double>()) / spacing));
+      fluid += n;
+    }
+  return fluid;
+}
+
+template <int Dim>
+struct FluidBlocks {
+  std::vector<Aabb<Dim>> blocks;
+  std::vector<std::int32_t> phase;  // of each block
+};
+
+template <int Dim, class Real>
+FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const PhaseTable& phases,
+                             const Regions<Dim>& regions, Particles<Dim, Real>& p) {
   if (!r.has("fluids")) r.fail("fluids", "missing (a list of fluid blocks is required)");
   auto fr = r.child("fluids");
   const std::size_t nf = fr.array_size();
   if (nf == 0) fr.fail_here("at least one fluid block is needed");
-  std::vector<Aabb<Dim>> blocks;
-  std::vector<std::int32_t> block_phase;
+  FluidBlocks<Dim> out;
   const double tol = 1e-9 * spacing;
   for (std::size_t k = 0; k < nf; ++k) {
     auto e = fr.element(k);
     if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
     const auto b = read_box<Dim>(e);
-    const std::int32_t phase = read_phase(e);
+    const std::int32_t phase = phases.read_reference(e);
     const auto vel = to_vec<Dim, Real>(e.vector("velocity", Dim, filled<Dim>(0)));
     e.finish();
     const auto n = cells_of<Dim>(b, spacing);
@@ -524,52 +626,64 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
       if (n[a] < 1)
         e.fail("max", "block holds no particle along axis " + std::to_string(a) + " (extent " +
                           std::to_string(b.hi[a] - b.lo[a]) + " < spacing " + std::to_string(spacing) + ")");
-    for (std::size_t o = 0; o < blocks.size(); ++o)
-      if (overlap<Dim>(b, blocks[o], tol))
+    for (std::size_t o = 0; o < out.blocks.size(); ++o)
+      if (overlap<Dim>(b, out.blocks[o], tol))
         e.fail_here("overlaps fluid block " + std::to_string(o) +
                     " (particles would sit on top of each other)");
-    for (std::size_t o = 0; o < solids.size(); ++o)
-      if (overlap<Dim>(b, solids[o], tol))
+    for (std::size_t o = 0; o < regions.solids.size(); ++o)
+      if (overlap<Dim>(b, regions.solids[o], tol))
         e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
-    if (container && !inside<Dim>(b, *container, tol)) e.fail_here("lies (partly) outside the boundary box");
-    blocks.push_back(b);
-    block_phase.push_back(phase);
+    if (regions.container && !inside<Dim>(b, *regions.container, tol))
+      e.fail_here("lies (partly) outside the boundary box");
+    out.blocks.push_back(b);
+    out.phase.push_back(phase);
     const std::size_t first = p.size();
     add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
     for (std::size_t i = first; i < p.size(); ++i) p.v[i] = vel;
   }
+  return out;
+}
+
+template <int Dim, class Real>
+void read_initial_pressure(JsonReader& r, double spacing, const SolverConfig<Dim, Real>& cfg,
+                           const PhaseTable& phases, const FluidBlocks<Dim>& fluids,
+                           Particles<Dim, Real>& p) {
   if (r.choice("initial_pressure", "zero", {"zero", "hydrostatic"}) == "hydrostatic")
-    start_hydrostatic(p, cfg, spacing, mass_given, blocks, block_phase);
+    start_hydrostatic(p, cfg, spacing, phases.mass_given, fluids.blocks, fluids.phase);
+}
 
-  // --- output ---------------------------------------------------------------------------------
-  if (r.has("output")) {
-    auto orr = r.child("output");
-    s.output.fps = orr.number("fps", s.output.fps, 1e-6, 1e6);
-    if (orr.has("formats")) {
-      const auto& fj = orr.json()["formats"];
-      if (!fj.is_array())
-        orr.fail("formats", "expected an array of vtu, ply, csv, got " + json_value_text(fj));
-      auto list = orr.child("formats");
-      s.output.formats.clear();
-      for (std::size_t k = 0; k < list.array_size(); ++k) {
-        const auto& v = fj[k];
-        if (!v.is_string() || (v != "vtu" && v != "ply" && v != "csv"))
-          list.element(k).fail_here("unknown format " + json_value_text(v) + " (expected vtu, ply or csv)");
-        s.output.formats.push_back(v.get<std::string>());
-      }
-    }
-    s.output.checkpoint_every =
-        static_cast<int>(orr.integer("checkpoint_every", s.output.checkpoint_every, 0, 1000000));
-    s.output.color_by = orr.choice("color_by", s.output.color_by, {"phase", "speed", "pressure"});
-    s.output.up_axis = static_cast<int>(orr.integer("up_axis", Dim - 1, 0, Dim - 1));
-    orr.finish();
-  } else {
-    s.output.up_axis = Dim - 1;
+// --- output (/output) ---------------------------------------------------------------------------
+template <int Dim>
+void read_output(JsonReader& r, OutputSettings& out) {
+  if (!r.has("output")) {
+    out.up_axis = Dim - 1;
+    return;
   }
-  r.finish();
+  auto orr = r.child("output");
+  out.fps = orr.number("fps", out.fps, 1e-6, 1e6);
+  if (orr.has("formats")) {
+    const auto& fj = orr.json()["formats"];
+    if (!fj.is_array()) orr.fail("formats", "expected an array of vtu, ply, csv, got " + json_value_text(fj));
+    auto list = orr.child("formats");
+    out.formats.clear();
+    for (std::size_t k = 0; k < list.array_size(); ++k) {
+      const auto& v = fj[k];
+      if (!v.is_string() || (v != "vtu" && v != "ply" && v != "csv"))
+        list.element(k).fail_here("unknown format " + json_value_text(v) + " (expected vtu, ply or csv)");
+      out.formats.push_back(v.get<std::string>());
+    }
+  }
+  out.checkpoint_every = static_cast<int>(orr.integer("checkpoint_every", out.checkpoint_every, 0, 1000000));
+  out.color_by = orr.choice("color_by", out.color_by, {"phase", "speed", "pressure"});
+  out.up_axis = static_cast<int>(orr.integer("up_axis", Dim - 1, 0, Dim - 1));
+  orr.finish();
+}
 
-  // The box drawn in pictures: the container, else the particles' bounds.
+// The box drawn in pictures: the container, else the particles' bounds.
+template <int Dim, class Real>
+void set_view(Scene<Dim, Real>& s, const std::optional<Aabb<Dim>>& container) {
   std::array<double, 3> lo{0, 0, 0}, hi{0, 0, 0};
+  const auto& p = s.particles;
   if (container) {
     for (std::size_t a = 0; a < Dim; ++a) {
       lo[a] = container->lo[a];
@@ -588,6 +702,43 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   }
   s.view_lo = lo;
   s.view_hi = hi;
+}
+
+}  // namespace
+
+template <int Dim, class Real>
+Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, const SceneLimits& limits) {
+  Scene<Dim, Real> s;
+  s.header = read_scene_header(j, source);
+  s.source = source;
+  CELLSPH_CHECK(s.header.dim == Dim, "scene dimension " << s.header.dim << " loaded as " << Dim);
+  JsonReader r(j, source, "");
+  // The header keys were checked by read_scene_header; mark them read here.
+  r.string("name", "");
+  r.string("description", "");
+  r.integer("dimension", 2, 2, 3);
+  r.string("precision", "");
+
+  const double spacing = r.required_number("spacing", 1e-9, 1e9);
+  s.spacing = static_cast<Real>(spacing);
+  auto& cfg = s.solver;
+  const PhaseTable phases = read_phases(r, spacing, cfg);
+  read_solver(r, spacing, cfg);
+  read_time(r, cfg, s.output);
+  read_neighbors(r, cfg);
+
+  // Particles: counted (fluid blocks first) before each is made, boundary before fluid.
+  ParticleBudget budget(Dim, spacing, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing,
+                        limits.memory_bytes);
+  budget.take(count_fluid_particles<Dim>(j, spacing), r, "fluids", "the fluid blocks");
+  Regions<Dim> regions = read_boundary(r, spacing, cfg, budget, s.particles);
+  read_domain(r, cfg, regions);
+  const FluidBlocks<Dim> fluids = read_fluids(r, spacing, phases, regions, s.particles);
+  read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
+
+  read_output<Dim>(r, s.output);
+  r.finish();
+  set_view(s, regions.container);
 
   try {
     cfg.validate();
@@ -597,9 +748,11 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source) 
   return s;
 }
 
-template Scene<2, float> load_scene<2, float>(const nlohmann::json&, const std::string&);
-template Scene<2, double> load_scene<2, double>(const nlohmann::json&, const std::string&);
-template Scene<3, float> load_scene<3, float>(const nlohmann::json&, const std::string&);
-template Scene<3, double> load_scene<3, double>(const nlohmann::json&, const std::string&);
+template Scene<2, float> load_scene<2, float>(const nlohmann::json&, const std::string&, const SceneLimits&);
+template Scene<2, double> load_scene<2, double>(const nlohmann::json&, const std::string&,
+                                                const SceneLimits&);
+template Scene<3, float> load_scene<3, float>(const nlohmann::json&, const std::string&, const SceneLimits&);
+template Scene<3, double> load_scene<3, double>(const nlohmann::json&, const std::string&,
+                                                const SceneLimits&);
 
 }  // namespace cellsph

@@ -59,12 +59,23 @@ void apply_scene_edits(nlohmann::json& j, const std::vector<std::string>& edits,
 
 SceneHeader read_scene_header(const nlohmann::json& j, const std::string& source);
 
-template <int Dim, class Real>
-Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source);
+// What load_scene may make. The particles a scene asks for are counted before any is made, at about
+// 256 bytes a particle plus 8 per neighbour pair, against this memory.
+struct SceneLimits {
+  double memory_bytes = 0;  // 0: this machine's physical memory; the fuzz harness sets a few MiB
+};
 
-extern template Scene<2, float> load_scene<2, float>(const nlohmann::json&, const std::string&);
-extern template Scene<2, double> load_scene<2, double>(const nlohmann::json&, const std::string&);
-extern template Scene<3, float> load_scene<3, float>(const nlohmann::json&, const std::string&);
-extern template Scene<3, double> load_scene<3, double>(const nlohmann::json&, const std::string&);
+template <int Dim, class Real>
+Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source,
+                            const SceneLimits& limits = {});
+
+extern template Scene<2, float> load_scene<2, float>(const nlohmann::json&, const std::string&,
+                                                     const SceneLimits&);
+extern template Scene<2, double> load_scene<2, double>(const nlohmann::json&, const std::string&,
+                                                       const SceneLimits&);
+extern template Scene<3, float> load_scene<3, float>(const nlohmann::json&, const std::string&,
+                                                     const SceneLimits&);
+extern template Scene<3, double> load_scene<3, double>(const nlohmann::json&, const std::string&,
+                                                       const SceneLimits&);
 
 }  // namespace cellsph

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/scene/scene.hpp"
@@ -158,6 +159,23 @@ TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
   std::filesystem::remove(path);
 }
 
+// A number beyond a double is valid JSON text that the parser cannot hold: it once ended in "internal
+// error" (nlohmann's out_of_range 406, not a parse_error); found by fuzz/scene_fuzz.cpp, input
+// fuzz/regressions/scene/number-beyond-double.
+TEST(Scene, NumberBeyondADoubleNamesFileLineAndColumn) {
+  const auto path = std::filesystem::temp_directory_path() / "cellsph_scene_overflow.json";
+  { std::ofstream(path) << "{\n  \"name\": \"x\",\n  \"spacing\": 1e400\n}\n"; }
+  std::string src;
+  try {
+    read_scene_json(path.string(), src);
+    FAIL() << "1e400 accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + ":3:14: invalid JSON (number 1e400 is beyond the range of a double)");
+  }
+  std::filesystem::remove(path);
+}
+
 // --set edits: numbers, arrays and bare words land at their pointer; the edited scene loads.
 TEST(Scene, EditsSetValuesAtTheirPointers) {
   auto j = nlohmann::json::parse(kMinimal);
@@ -196,6 +214,36 @@ TEST(Scene, BadEditsNameTheEdit) {
   EXPECT_NE(err.find("/spacng"), std::string::npos) << err;
 }
 
+// A --set value that is not JSON is taken as a string, and a JSON string must be UTF-8: a value with other
+// bytes once passed the edit and ended in "internal error" where it was printed or saved to run.json
+// (found by fuzz/scene_fuzz.cpp; the input is fuzz/regressions/scene/invalid-utf8-in-set-value). The
+// invalid sequences are the standard ones: a stray 0xFF, an overlong '/', a UTF-16 surrogate, a 2-byte
+// lead at the end.
+TEST(Scene, EditsThatAreNotUtf8AreRefusedWithTheOffset) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"/description=\xff", "byte 0xFF at offset 13"},
+      {"/description=a\xc0\xaf", "byte 0xC0 at offset 14"},
+      {"/neighbors={\"method\":\"\xed\xa0\x80\"}", "byte 0xED at offset 22"},
+      {"/name=x\xc3", "byte 0xC3 at offset 7"}};
+  for (const auto& [edit, where] : cases) {
+    auto j = nlohmann::json::parse(kMinimal);
+    std::string src = "scene.json";
+    try {
+      apply_scene_edits(j, {edit}, src);
+      FAIL() << "accepted " << edit;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is not valid UTF-8 (" + where + ")"), std::string::npos)
+          << e.what();
+    }
+  }
+  // Well-formed UTF-8 of 2, 3 and 4 bytes is a string like any other.
+  auto j = nlohmann::json::parse(kMinimal);
+  std::string src = "scene.json";
+  apply_scene_edits(j, {"/description=caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x8c\x8a"}, src);
+  EXPECT_EQ(j["description"], "caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x8c\x8a");
+  EXPECT_EQ(load_error(j), "");
+}
+
 // A spacing far too fine stops before any particle is made, naming the object that goes over and the
 // count (3e12 fluid particles: more than 2^31 on any machine), instead of allocating for hours.
 TEST(Scene, TooManyParticlesIsAnInputErrorBeforeAnyIsMade) {
@@ -217,6 +265,29 @@ TEST(Scene, TooManyParticlesIsAnInputErrorBeforeAnyIsMade) {
   j = read_scene_json("dam-break-3d", src);
   apply_scene_edits(j, {"/spacing=2e-4", "/solver/support=4e-4"}, src);
   EXPECT_THROW((load_scene<3, float>(j, src)), InputError);
+}
+
+// SceneLimits::memory_bytes replaces the machine's memory in the count (the fuzz harness loads scenes on a
+// budget of a few MiB). kMinimal makes 10 x 5 = 50 particles; with the default support (2 spacings) and
+// skin (0.15) each has pi 2.3^2 = 16.6 pairs, 256 + 8 x 16.6 = 389 bytes by the cost model of
+// docs/scenes.md: 50 particles fit in 60 x 389 bytes, not in 40 x 389.
+TEST(Scene, MemoryLimitCapsTheParticles) {
+  const auto j = nlohmann::json::parse(kMinimal);
+  SceneLimits roomy, tight;
+  roomy.memory_bytes = 60 * 389;
+  tight.memory_bytes = 40 * 389;
+  EXPECT_EQ((load_scene<2, double>(j, "scene.json", roomy).particles.size()), 50u);
+  try {
+    load_scene<2, double>(j, "scene.json", tight);
+    FAIL() << "50 particles accepted in the memory of 40";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(
+        m.find("scene.json: /fluids: with the fluid blocks at spacing 0.1 m the scene has 50 particles, "
+               "more than 40 (what the allowed "),
+        std::string::npos)
+        << m;
+  }
 }
 
 }  // namespace

@@ -976,6 +976,49 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
                        std::to_string(int(particles.kind[i])) + ", not in this scene's tables");
     }
   }
+  // Values no run holds (a checkpoint from another writer, or edited with its checksum fixed): refused
+  // here, where the step would meet them as an internal error or undefined behaviour (non-finite
+  // coordinates in the neighbour search, a shift by a level outside 0..max_level, ticks that overflow).
+  particles.for_each_field([&](std::string_view name, const auto& field) {
+    using T = typename std::remove_cvref_t<decltype(field)>::value_type;
+    for (std::size_t i = 0; i < field.size(); ++i) {
+      bool finite = true;
+      if constexpr (std::is_same_v<T, Real>) {
+        finite = std::isfinite(field[i]);
+      } else if constexpr (std::is_same_v<T, V>) {
+        for (int a = 0; a < Dim; ++a) finite = finite && std::isfinite(field[i][a]);
+      }
+      if (!finite)
+        throw InputError(source + ": particle " + std::to_string(i) + " has a non-finite " +
+                         std::string(name));
+    }
+  });
+  if (!(std::isfinite(state.time) && state.time >= 0 && std::isfinite(state.last_dt) && state.last_dt >= 0))
+    throw InputError(source + ": simulated time " + std::to_string(state.time) + " / last step " +
+                     std::to_string(state.last_dt) + " is not a finite number >= 0");
+  // Every particle's support is the scene's (set at construction, never changed), and per-particle steps
+  // keep every fluid particle's tick within 2^max_level of the earliest (a due particle moves at most
+  // dt_max ahead), so no step extrapolates a position further than dt_max.
+  const std::int64_t max_tick = std::int64_t{1} << 62, spread = std::int64_t{1} << cfg_.time.max_level;
+  std::int64_t lo_tick = max_tick, hi_tick = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (particles.h[i] != cfg_.support)
+      throw InputError(source + ": particle " + std::to_string(i) + " has support " +
+                       std::to_string(particles.h[i]) + ", the scene's is " + std::to_string(cfg_.support));
+    if (particles.level[i] < 0 || particles.level[i] > cfg_.time.max_level || particles.tick[i] < 0 ||
+        particles.tick[i] > max_tick)
+      throw InputError(source + ": particle " + std::to_string(i) + " has time-step level " +
+                       std::to_string(particles.level[i]) + " / tick " + std::to_string(particles.tick[i]) +
+                       ", outside 0.." + std::to_string(cfg_.time.max_level) + " / 0..2^62");
+    if (particles.kind[i] == kFluid) {
+      lo_tick = std::min(lo_tick, particles.tick[i]);
+      hi_tick = std::max(hi_tick, particles.tick[i]);
+    }
+  }
+  if (hi_tick > lo_tick && hi_tick - lo_tick > spread)
+    throw InputError(source + ": fluid particles' ticks span " + std::to_string(lo_tick) + ".." +
+                     std::to_string(hi_tick) + ", more than 2^" + std::to_string(cfg_.time.max_level) +
+                     " (one largest step)");
   p_ = std::move(particles);
   fluid_.clear();
   boundary_.clear();
@@ -987,8 +1030,16 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   }
   fluid_count_ = fluid_.size();
   lists_valid_ = false;
-  // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder).
-  if (cfg_.wall_model == WallModel::Dynamic) init_boundary_weights();
+  // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
+  // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
+  // the file's fault, named as such (the Simulation is then not usable; the caller stops).
+  if (cfg_.wall_model == WallModel::Dynamic) {
+    try {
+      init_boundary_weights();
+    } catch (const CapacityError& e) {
+      throw InputError(source + ": " + e.what());
+    }
+  }
   time_ = state.time;
   last_dt_ = state.last_dt;
   steps_ = state.steps;

@@ -101,7 +101,10 @@ class Simulation {
   }
   // Replaces the particles and the integrator state. Throws InputError, prefixed with `source` (the
   // checkpoint file), when the particles do not fit this simulation: count, phase or kind not in its
-  // tables, ids not a permutation. The simulation is untouched on error. The particles keep their
+  // tables, ids not a permutation, values no run holds (non-finite, support <= 0, time-step level or tick
+  // out of range, non-finite or negative time). The simulation is untouched on those errors; with dynamic
+  // walls, positions beyond what the neighbour search indexes are found after the particles were
+  // replaced (InputError too; the simulation must not be stepped then). The particles keep their
   // order (a checkpoint holds the internal order, so a resume is bit for bit).
   void restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state, const std::string& source);
 
