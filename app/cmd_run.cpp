@@ -31,6 +31,8 @@
 #include "cellsph/core/timer.hpp"
 #include "cellsph/io/frame_output.hpp"
 #include "cellsph/io/simulation_checkpoint.hpp"
+#include "cellsph/probes/probe_log.hpp"
+#include "cellsph/probes/probes.hpp"
 #include "cellsph/render/renderer.hpp"
 #include "cellsph/render/video.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
@@ -255,6 +257,21 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     loop.decode(read_simulation_checkpoint(ckpt_path, sim), ckpt_path);
     frames.resume(loop.next_frame);
   }
+  // Probes: sampled when the clock passes k * probes_every (one row per step at most); the count due
+  // follows from the time alone, so a resume continues the same schedule, and probes.csv keeps its
+  // rows up to the checkpoint's time (every one of them was flushed before that checkpoint).
+  const bool probing = !scene.probes.empty();
+  const ProbeSampler<Dim, Real> sampler(scene.probes, cfg.density_kernel, double(cfg.support),
+                                        double(scene.spacing));
+  ProbeLog probe_log(out / "probes.csv", probe_columns(scene.probes, Dim));
+  std::uint64_t next_probe = 0;
+  auto probes_due = [&] {
+    return probing && double(sim.time()) >= double(next_probe) * scene.probes_every * (1 - 1e-12);
+  };
+  if (resuming && probing) {
+    probe_log.resume(double(sim.time()));
+    while (probes_due()) ++next_probe;
+  }
 
   // ---- Everything is valid: from here on the run writes.
   if (g_stop_signal) {
@@ -275,7 +292,15 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   const double t_at_start = double(sim.time());
   const double frame_dt = 1.0 / os.fps;
 
-  auto write_checkpoint = [&] { write_simulation_checkpoint(sim, loop.encode(), ckpt_path); };
+  auto sample_probes = [&] {
+    if (!probes_due()) return;
+    probe_log.add(double(sim.time()), sampler.sample(sim.particles()));
+    while (probes_due()) ++next_probe;
+  };
+  auto write_checkpoint = [&] {
+    if (probing) probe_log.flush();  // every row up to the checkpoint's time is on disk first
+    write_simulation_checkpoint(sim, loop.encode(), ckpt_path);
+  };
   auto write_frame = [&] {
     Stopwatch sw;
     const double t = double(sim.time());
@@ -283,6 +308,7 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     if (opt.render)
       render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
     if (opt.surface) write_surfaces(sim.particles(), sopt, surface_dir, loop.next_frame);
+    if (probing) probe_log.flush();
     ++loop.next_frame;
     if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0)
       write_checkpoint();
@@ -306,9 +332,11 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     return double(sim.time()) >= os.end_time * (1 - 1e-12);
   };
   try {
+    sample_probes();
     write_due_frames();
     while (!done() && !g_stop_signal) {
       sim.step();
+      sample_probes();
       write_due_frames();
       const double frac =
           opt.steps >= 0 ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
@@ -324,6 +352,7 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     throw;
   }
   progress.finish();
+  if (probing) probe_log.flush();
   if (const int sig = g_stop_signal) {
     // Stopped between two steps: the state after the last step, with its frame counter, so the resume
     // continues exactly as the run would have (frames after the last one written follow on resume).

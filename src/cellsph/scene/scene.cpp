@@ -679,6 +679,36 @@ void read_output(JsonReader& r, OutputSettings& out) {
   orr.finish();
 }
 
+// --- probes (/probes, /probes_every) -------------------------------------------------------------
+template <int Dim>
+void read_probes(JsonReader& r, std::vector<Probe>& probes, double& every) {
+  every = r.number("probes_every", every, 1e-9, 1e9);
+  if (!r.has("probes")) return;
+  const auto& pj = r.json()["probes"];
+  if (!pj.is_array())
+    r.fail("probes", "expected an array of {\"name\", \"kind\", \"at\"}, got " + json_value_text(pj));
+  auto list = r.child("probes");
+  std::vector<std::string> taken{"time"};
+  for (std::size_t k = 0; k < list.array_size(); ++k) {
+    auto e = list.element(k);
+    Probe pr;
+    if (!e.has("name")) e.fail("name", "required: the probe's column name in probes.csv");
+    pr.name = e.string("name", "");
+    if (pr.name.empty() || pr.name.find_first_of(",\"\r\n") != std::string::npos)
+      e.fail("name", "'" + pr.name + "' is not a CSV column name (non-empty, no comma, quote or line break)");
+    for (const auto& c : probe_columns({pr}, Dim))
+      for (const auto& t : taken)
+        if (c == t) e.fail("name", "'" + pr.name + "' gives the column '" + c + "', which is already taken");
+    if (!e.has("kind")) e.fail("kind", "required: pressure, level or velocity");
+    pr.kind = *parse_probe_kind(e.choice("kind", "pressure", {"pressure", "level", "velocity"}));
+    const auto at = e.required_vector("at", Dim);
+    for (std::size_t a = 0; a < Dim; ++a) pr.at[a] = at[a];
+    e.finish();
+    for (const auto& c : probe_columns({pr}, Dim)) taken.push_back(c);
+    probes.push_back(std::move(pr));
+  }
+}
+
 // The box drawn in pictures: the container, else the particles' bounds.
 template <int Dim, class Real>
 void set_view(Scene<Dim, Real>& s, const std::optional<Aabb<Dim>>& container) {
@@ -737,6 +767,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
 
   read_output<Dim>(r, s.output);
+  read_probes<Dim>(r, s.probes, s.probes_every);
   r.finish();
   set_view(s, regions.container);
 

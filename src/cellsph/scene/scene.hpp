@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/probes/probes.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/particles.hpp"
 
@@ -43,6 +44,8 @@ struct Scene {
   Particles<Dim, Real> particles;  // initial fluid and boundary particles
   OutputSettings output;
   std::array<double, 3> view_lo{}, view_hi{};  // the box drawn in pictures
+  std::vector<Probe> probes;                   // sampled into probes.csv (probes/probes.hpp)
+  double probes_every = 0.01;                  // [s] between probe samples
 };
 
 // A scene's JSON text: `name_or_path` is a built-in scene name or a path to a .json file. `source`
