@@ -73,8 +73,8 @@ struct ColorField {
 
 // Algorithm 1, lines 11-12: grad C_i += V_j c_j grad W^poly, lap C_i += V_j c_j lap W^poly.
 template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline void accumulate_color(ColorField<Dim, Real>& c, const Vec<Dim, Real>& xij, Real r, Real vj,
-                                        Real cj, const Kernel& w) {
+CELLSPH_HD CELLSPH_INLINE void accumulate_color(ColorField<Dim, Real>& c, const Vec<Dim, Real>& xij, Real r,
+                                                Real vj, Real cj, const Kernel& w) {
   c.grad += w.gradW(xij) * (vj * cj);
   c.lap += vj * cj * w.laplacian(r);
 }

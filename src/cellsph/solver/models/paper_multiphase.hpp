@@ -81,14 +81,15 @@ struct PaperForcesPass {
       const Real r = norm(xij);
       if (pv.is_fluid(j)) {
         // eq. 8a, 8b with the per-particle volumes of the density pass.
-        f += averaged_pressure_force(wp.gradW(xij), vol_i, pv.vol[j], pi, pv.p[j]);
-        f += averaged_viscosity_force(vel_i - pv.v[j], vol_i, pv.vol[j], mui, pv.mu[j], wv.laplacian(r));
+        const Real vol_j = pv.vol[j];
+        f += averaged_pressure_force(wp.gradW(xij), vol_i, vol_j, pi, pv.p[j]);
+        f += averaged_viscosity_force(vel_i - pv.v[j], vol_i, vol_j, mui, pv.mu[j], wv.laplacian(r));
         if (csf_i && norm2(pv.normal[j]) > thr2 && norm2(pv.normal[j]) > 0) {
           const V nhat_j = pv.normal[j] / norm(pv.normal[j]);
-          kappa -= pv.vol[j] * dot(nhat_j - nhat_i, wc.gradW(xij));
-          wsum += pv.vol[j] * wc.W2(r * r);
+          kappa -= vol_j * dot(nhat_j - nhat_i, wc.gradW(xij));
+          wsum += vol_j * wc.W2(r * r);
         } else if (eq9) {
-          accumulate_color(cf, xij, r, pv.vol[j], pv.color[j], wc);
+          accumulate_color(cf, xij, r, vol_j, pv.color[j], wc);
         } else if (akinci && pv.phase[j] == pv.phase[i] && r > 0) {
           // Akinci 2013: each factor is symmetric in (i, j) and x_ij, n_i - n_j antisymmetric: the
           // pair's forces on i and j are exact opposites.
@@ -108,9 +109,10 @@ struct PaperForcesPass {
         // eq. 8b against a particle at rest with i's mu.
         const Real mj = pv.m[j];
         if (wall_states) {
-          f += averaged_pressure_force(wp.gradW(xij), vol_i, pv.vol[j], pi, pv.p[j]);
+          const Real vol_j = pv.vol[j];
+          f += averaged_pressure_force(wp.gradW(xij), vol_i, vol_j, pi, pv.p[j]);
           if (no_slip)
-            f += averaged_viscosity_force(vel_i - pv.wall_v[j], vol_i, pv.vol[j], mui, mui, wv.laplacian(r));
+            f += averaged_viscosity_force(vel_i - pv.wall_v[j], vol_i, vol_j, mui, mui, wv.laplacian(r));
         } else {
           const Real pj = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
           f += averaged_pressure_force(wp.gradW(xij), mi / rhoi, mj / rhoi, pi, pj);
