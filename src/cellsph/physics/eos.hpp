@@ -71,7 +71,7 @@ struct EquationOfState {
   }
 
   // Speed of sound c = sqrt(dp/drho) at rest density, for the Courant condition (eq. 12).
-  Real sound_speed(Real rho0) const {
+  CELLSPH_HD Real sound_speed(Real rho0) const {
     switch (kind) {
       case EosKind::Tait:
         return std::sqrt(stiffness * gamma / rho0);

@@ -1,7 +1,10 @@
 #pragma once
-// Each SPH interaction written once, as a small inline function of a small struct of inputs, so that a
-// CPU loop (solver/) and a device kernel can both call it. Convention: x_ij = x_i - x_j, v_ij = v_i - v_j,
-// and every function returns the contribution of neighbour j to particle i.
+// Each SPH interaction written once, as a small inline CELLSPH_HD function, so that the solver's passes
+// (solver/models, solver/boundary) on the CPU and a device kernel all call the same expression.
+// Convention: x_ij = x_i - x_j, v_ij = v_i - v_j, and every function returns the contribution of
+// neighbour j to particle i. The passes call the forms over per-particle quantities (volumes V = m / rho
+// and p / rho^2 computed once per particle by the density pass, one kernel gradient per pair); the
+// PairInput forms compute those from masses and densities and call them (same expressions).
 #include <cmath>
 
 #include "cellsph/core/hd.hpp"
@@ -33,17 +36,31 @@ CELLSPH_HD inline Real density_term(const Kernel& w, Real mj, Real r2) {
 // ---- The paper's averaged forces (eq. 8a, 8b) --------------------------------------------------
 
 // eq. 8a: -V_i V_j (P_i + P_j)/2 grad W^press. Antisymmetric in i and j, so momentum is conserved.
-template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Vec<Dim, Real> averaged_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
-  const Real vi = in.mi / in.rhoi, vj = in.mj / in.rhoj;
-  return w.gradW(in.xij) * (-vi * vj * (in.pi + in.pj) / 2);
+// grad_w = grad W^press(x_ij).
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> averaged_pressure_force(const Vec<Dim, Real>& grad_w, Real vol_i, Real vol_j,
+                                                         Real pi, Real pj) {
+  return grad_w * (-vol_i * vol_j * (pi + pj) / 2);
 }
 
 // eq. 8b: V_i V_j (mu_i + mu_j)/2 (v_j - v_i) lap W^visco. Symmetric weight, antisymmetric velocity.
+// lap_w = lap W^visco(r_ij). Against a wall with i's viscosity the caller passes mu_j = mu_i ((mu + mu)/2
+// is mu exactly).
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> averaged_viscosity_force(const Vec<Dim, Real>& vij, Real vol_i, Real vol_j,
+                                                          Real mui, Real muj, Real lap_w) {
+  return vij * (-vol_i * vol_j * (mui + muj) / 2 * lap_w);
+}
+
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> averaged_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
+  return averaged_pressure_force(w.gradW(in.xij), in.mi / in.rhoi, in.mj / in.rhoj, in.pi, in.pj);
+}
+
 template <int Dim, class Real, class Kernel>
 CELLSPH_HD inline Vec<Dim, Real> averaged_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w) {
-  const Real vi = in.mi / in.rhoi, vj = in.mj / in.rhoj;
-  return in.vij * (-vi * vj * (in.mui + in.muj) / 2 * w.laplacian(in.r));
+  return averaged_viscosity_force(in.vij, in.mi / in.rhoi, in.mj / in.rhoj, in.mui, in.muj,
+                                  w.laplacian(in.r));
 }
 
 // ---- Colour field and interface tension (eq. 8c, 9; Mueller 2003 surface tension) ----------------
@@ -56,8 +73,8 @@ struct ColorField {
 
 // Algorithm 1, lines 11-12: grad C_i += V_j c_j grad W^poly, lap C_i += V_j c_j lap W^poly.
 template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline void accumulate_color(ColorField<Dim, Real>& c, const Vec<Dim, Real>& xij, Real r, Real vj,
-                                        Real cj, const Kernel& w) {
+CELLSPH_HD CELLSPH_INLINE void accumulate_color(ColorField<Dim, Real>& c, const Vec<Dim, Real>& xij, Real r,
+                                                Real vj, Real cj, const Kernel& w) {
   c.grad += w.gradW(xij) * (vj * cj);
   c.lap += vj * cj * w.laplacian(r);
 }
@@ -74,23 +91,41 @@ CELLSPH_HD inline Vec<Dim, Real> interface_tension_force(const ColorField<Dim, R
 
 // ---- The write-up's WCSPH forces ---------------------------------------------------------------
 
-// Symmetric pressure force: -m_i m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij (momentum conserving).
-template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
-  const Real a = in.pi / (in.rhoi * in.rhoi) + in.pj / (in.rhoj * in.rhoj);
-  return w.gradW(in.xij) * (-in.mi * in.mj * a);
+// Symmetric pressure force: -m_i m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij (momentum conserving), from
+// prho2 = p / rho^2 of each particle.
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const Vec<Dim, Real>& grad_w, Real mi, Real mj,
+                                                          Real prho2_i, Real prho2_j) {
+  return grad_w * (-mi * mj * (prho2_i + prho2_j));
 }
 
 // Monaghan's viscosity operator (SPH derivative combined with a finite difference, Koschier et al. 2020):
 //   lap v_i = 2(d+2) sum_j V_j (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2) grad W_ij,
-// the 0.01 h^2 keeping the quotient finite as r -> 0. Written as a force with V_i V_j and the mean dynamic
-// viscosity, so that f_ij = -f_ji exactly.
+// the 0.01 h^2 (eps2) keeping the quotient finite as r -> 0. Written as a force with V_i V_j and the mean
+// dynamic viscosity, so that f_ij = -f_ji exactly. Against a wall with i's viscosity the caller passes
+// mu_j = mu_i.
+template <int Dim, class Real>
+CELLSPH_HD inline Real monaghan_quotient(const Vec<Dim, Real>& vij, const Vec<Dim, Real>& xij, Real r,
+                                         Real eps2) {
+  return dot(vij, xij) / (r * r + eps2);
+}
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> monaghan_viscosity_force(const Vec<Dim, Real>& grad_w, Real vol_i,
+                                                          Real vol_j, Real mui, Real muj, Real q) {
+  return grad_w * (Real(2 * (Dim + 2)) * (mui + muj) / 2 * vol_i * vol_j * q);
+}
+
+template <int Dim, class Real, class Kernel>
+CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
+  return symmetric_pressure_force(w.gradW(in.xij), in.mi, in.mj, in.pi / (in.rhoi * in.rhoi),
+                                  in.pj / (in.rhoj * in.rhoj));
+}
+
 template <int Dim, class Real, class Kernel>
 CELLSPH_HD inline Vec<Dim, Real> monaghan_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w,
                                                           Real h) {
-  const Real vi = in.mi / in.rhoi, vj = in.mj / in.rhoj;
-  const Real q = dot(in.vij, in.xij) / (in.r * in.r + Real(0.01) * h * h);
-  return w.gradW(in.xij) * (Real(2 * (Dim + 2)) * (in.mui + in.muj) / 2 * vi * vj * q);
+  const Real q = monaghan_quotient(in.vij, in.xij, in.r, Real(0.01) * h * h);
+  return monaghan_viscosity_force(w.gradW(in.xij), in.mi / in.rhoi, in.mj / in.rhoj, in.mui, in.muj, q);
 }
 
 // ---- Boundary particles (Akinci et al. 2012) ----------------------------------------------------

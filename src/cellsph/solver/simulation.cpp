@@ -15,9 +15,20 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/timer.hpp"
-#include "cellsph/physics/interactions.hpp"
 #include "cellsph/physics/kernels.hpp"
-#include "cellsph/solver/boundaries.hpp"
+#include "cellsph/solver/boundary/adami2012.hpp"
+#include "cellsph/solver/boundary/akinci2012.hpp"
+#include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
+#include "cellsph/solver/boundary/wall_neighbors.hpp"
+#include "cellsph/solver/integration/collisions.hpp"
+#include "cellsph/solver/models/paper_multiphase.hpp"
+#include "cellsph/solver/models/summation_density.hpp"
+#include "cellsph/solver/models/wcsph.hpp"
+#include "cellsph/solver/pass_driver.hpp"
+#include "cellsph/solver/stability_check.hpp"
+#include "cellsph/solver/timestep/global_courant.hpp"
+#include "cellsph/solver/timestep/per_particle_levels.hpp"
+#include "cellsph/solver/verlet_rows.hpp"
 
 namespace cellsph {
 
@@ -59,6 +70,7 @@ template <int Dim, class Real>
 Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
     : cfg_(std::move(config)), p_(std::move(particles)), search_(cfg_.search) {
   cfg_.validate();
+  for (const auto& ph : cfg_.phases) phase_params_.push_back({ph.rest_density, ph.viscosity, ph.sigma});
   const std::size_t n = p_.x.size();
   // Inputs that may be left empty get their defaults; any other size mismatch is an error.
   auto complete = [n](auto& field, const char* name, auto value) {
@@ -158,47 +170,51 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   lists_valid_ = false;
 }
 
-// f(i) for every fluid particle, split statically over the fluid particles alone: boundary particles
-// (often as many as the fluid, and stored after it) would otherwise leave one thread idle.
 template <int Dim, class Real>
-template <class F>
-void Simulation<Dim, Real>::for_fluid(F&& f) const {
-  for_each_of(fluid_, f);
+ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
+  ParticleView<Dim, Real> v;
+  v.n = p_.size();
+  v.x = p_.x.data();
+  v.v = p_.v.data();
+  v.f = p_.f.data();
+  v.m = p_.m.data();
+  v.rho = p_.rho.data();
+  v.p = p_.p.data();
+  v.h = p_.h.data();
+  v.color = p_.color.data();
+  v.mu = p_.mu.data();
+  v.phase = p_.phase.data();
+  v.level = p_.level.data();
+  v.tick = p_.tick.data();
+  v.kind = p_.kind.data();
+  v.id = p_.id.data();
+  v.rho0 = rho0_.data();
+  v.vol = vol_.data();
+  v.prho2 = prho2_.data();
+  v.normal = normal_.data();
+  v.f_pressure = f_pressure_.data();
+  v.wall_v = wall_v_.data();
+  v.wall_self_rho = wall_self_rho_.data();
+  v.offsets = nl_.offsets.data();
+  v.candidates = nl_.indices.data();
+  v.within = within_.data();
+  v.within_count = within_count_.data();
+  v.wall_start = walls_.start.data();
+  v.wall_nbr = walls_.nbr.data();
+  v.phases = phase_params_.data();
+  return v;
 }
 
-template <int Dim, class Real>
-template <class F>
-void Simulation<Dim, Real>::for_each_of(const IndexList& set, F&& f) const {
-  const std::uint32_t* idx = set.data();
-  parallel_for(set.size(), [&](std::size_t k) { f(static_cast<std::size_t>(idx[k])); });
-}
-
-// Akinci et al. 2012: V_b = 1 / sum_k W_bk over boundary particles (self included), psi_b = rho0 V_b.
-// Irregular sampling of a wall then still gives the same density contribution per unit area.
+// Akinci et al. 2012 weights (boundary/akinci2012.hpp) and, for dynamic walls, each wall's fixed
+// wall-wall density (boundary/dynamic_crespo2007.hpp), from a search with the rows of every particle.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::init_boundary_weights() {
   if (fluid_count_ == p_.size()) return;
   compute_neighbors(true);
-  with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
-    parallel_for(p_.size(), [&](std::size_t b) {
-      if (p_.kind[b] != kBoundary || p_.m[b] > 0) return;  // a weight given by the scene is kept
-      Real s = w.W2(0);
-      for (const auto* it = nl_.begin(b); it != nl_.end(b); ++it)
-        if (p_.kind[*it] == kBoundary) s += w.W2(distance2(p_.x[b], p_.x[*it]));
-      p_.m[b] = rho0_[b] / s;
-    });
-    // Dynamic walls: the wall-wall part of each wall's summation density, fixed for the run (weights
-    // first: a neighbour's weight may have just been set above). Summed in row order (ascending).
-    if (cfg_.wall_model != WallModel::Dynamic) return;
-    wall_self_rho_.assign(p_.size(), Real(0));
-    parallel_for(p_.size(), [&](std::size_t b) {
-      if (p_.kind[b] != kBoundary) return;
-      Real s = p_.m[b] * w.W2(0);
-      for (const auto* it = nl_.begin(b); it != nl_.end(b); ++it)
-        if (p_.kind[*it] == kBoundary) s += p_.m[*it] * w.W2(distance2(p_.x[b], p_.x[*it]));
-      wall_self_rho_[b] = s;
-    });
-  });
+  akinci2012_weights(cfg_, view());
+  if (cfg_.wall_model != WallModel::Dynamic) return;
+  wall_self_rho_.assign(p_.size(), Real(0));
+  dynamic_wall_self_density(cfg_, view());
 }
 
 // Cells of size h counted from the lowest corner of these particles, keyed in Z-order; equal keys by id.
@@ -261,13 +277,9 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     return;
   }
   if (lists_valid_ && skin_ > 0) {
-    Real d2 = 0;  // largest squared displacement since the lists were built (order-free: a maximum)
-    const auto count = static_cast<std::int64_t>(fluid_.size());
-#pragma omp parallel for schedule(static) reduction(max : d2)
-    for (std::int64_t k = 0; k < count; ++k) {
-      const std::size_t i = fluid_[static_cast<std::size_t>(k)];
-      d2 = std::max(d2, distance2(p_.x[i], x_built_[i]));
-    }
+    // The largest squared displacement since the lists were built (order-free: a maximum).
+    const Real d2 =
+        reduce_max(fluid_, MaxValue<Real>{}, MaxDisplacementPass<Dim, Real>{view(), x_built_.data()}).value;
     const Real limit = Real(0.45) * skin_;
     if (d2 <= limit * limit) return;
   }
@@ -278,404 +290,93 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   ++timings_.list_builds;
 }
 
-// The rows of `set` cut down to the pairs within h_i, in the same (ascending) order: every pair loop
-// then runs without the skin test. That test is a branch taken for about a third of the candidates;
-// once the particles are in cell order (reorder_every) its pattern along a sorted row is irregular, and
-// the mispredictions cost more than this pass (which writes each candidate and advances by the test's
-// outcome, without a branch). The test is the one the loops made before: the same pairs, the same bits.
+// The rows of `set` cut down to the pairs within h_i (verlet_rows.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::filter_lists(const IndexList& set) {
   within_.resize(nl_.indices.size());
   within_count_.resize(p_.size());
-  for_each_of(set, [&](std::size_t i) {
-    const V xi = p_.x[i];
-    const Real hi2 = p_.h[i] * p_.h[i];
-    std::uint32_t* out = within_.data() + nl_.offsets[i];
-    std::uint32_t c = 0;
-    for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
-      const std::uint32_t j = *it;
-      out[c] = j;
-      c += distance2(xi, p_.x[j]) <= hi2 ? 1u : 0u;
-    }
-    within_count_[i] = c;
-  });
+  run_pass(set, FilterRowsPass<Dim, Real>{view()});
 }
 
-// Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state.
+// Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state
+// (models/summation_density.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
   timings_.density_evals += set.size();
-  const bool number = cfg_.density == DensityFormulation::Number && cfg_.model == Model::PaperMultiphase;
   vol_.resize(p_.size());
   prho2_.resize(p_.size());
-  with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
-    for_each_of(set, [&](std::size_t i) {
-      const V xi = p_.x[i];
-      Real rho = 0;
-      if (number) {
-        // Each neighbour counts by its volume, not its mass, so a light particle next to a heavy one
-        // is not given the heavy one's density. A wall particle of volume V_b = psi_b / rho0_b counts as
-        // V_b / V_i fluid particles (V_i = m_i / rho0_i), so that with one phase this is eq. 7 exactly.
-        Real delta = w.W2(0);
-        const Real inv_vol_i = rho0_[i] / p_.m[i];
-        for (const auto* it = in_begin(i); it != in_end(i); ++it) {
-          const std::uint32_t j = *it;
-          const Real r2 = distance2(xi, p_.x[j]);
-          const Real wij = w.W2(r2);
-          delta += p_.kind[j] == kFluid ? wij : wij * (p_.m[j] / rho0_[j]) * inv_vol_i;
-        }
-        rho = p_.m[i] * delta;
-      } else {
-        rho = density_term(w, p_.m[i], Real(0));
-        for (const auto* it = in_begin(i); it != in_end(i); ++it) {
-          const Real r2 = distance2(xi, p_.x[*it]);
-          rho += density_term(w, p_.m[*it], r2);
-        }
-      }
-      p_.rho[i] = rho;
-      const Real pres = cfg_.eos.pressure(rho, rho0_[i]);
-      p_.p[i] = pres;
-      vol_[i] = p_.m[i] / rho;
-      prho2_[i] = pres / (rho * rho);
-    });
-  });
+  summation_density(cfg_, view(), set);
 }
 
-// Adami, Hu & Adams 2012, for walls at rest (a_w = 0):
-//   p_w = (sum_f p_f W_wf + g . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf       (their eq. 27)
-//   rho_w = the density at which the equation of state gives p_w                 (their eq. 28)
-//   v~_w = 2 v_w - sum_f v_f W_wf / sum_f W_wf = -(the kernel average)            (their eq. 22-23)
-// over the fluid particles f within h_f of w. A step searches boundary particles with support 0 (they
-// have no rows), so the wall's neighbours are gathered from the fluid rows: counted, placed, then each
-// wall's list sorted, so every sum runs in ascending fluid index whatever the thread count or the
-// neighbour method (the set is exactly {f : |x_w - x_f| <= h_f}, the pairs the force pass sees).
+// Adami or dynamic walls: each wall particle's pressure, density (and no-slip velocity) from its fluid
+// neighbours, after the density pass (boundary/adami2012.hpp, boundary/dynamic_crespo2007.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_wall_states() {
-  const std::size_t n = p_.size();
   if (boundary_.empty()) return;
-  wall_start_.assign(n + 1, 0);
-  auto each_wall_pair = [&](auto&& visit) {
-    for_fluid([&](std::size_t f) {
-      for (const auto* it = in_begin(f); it != in_end(f); ++it) {  // filter_lists: within h_f
-        const std::uint32_t b = *it;
-        if (p_.kind[b] == kBoundary) visit(f, b);
-      }
-    });
-  };
-  each_wall_pair([&](std::size_t, std::uint32_t b) {
-    std::atomic_ref<std::uint32_t>(wall_start_[b + 1]).fetch_add(1, std::memory_order_relaxed);
-  });
-  for (std::size_t i = 0; i < n; ++i) wall_start_[i + 1] += wall_start_[i];
-  wall_nbr_.resize(wall_start_[n]);
-  std::vector<std::uint32_t>& cursor = wall_cursor_;
-  cursor.assign(wall_start_.begin(), wall_start_.end() - 1);
-  each_wall_pair([&](std::size_t f, std::uint32_t b) {
-    const std::uint32_t k = std::atomic_ref<std::uint32_t>(cursor[b]).fetch_add(1, std::memory_order_relaxed);
-    wall_nbr_[k] = static_cast<std::uint32_t>(f);
-  });
-  wall_v_.resize(n);
-  with_kernel<Dim, Real>(cfg_.density_kernel, cfg_.support, [&](const auto w) {
-    for_each_of(boundary_, [&](std::size_t b) {
-      std::uint32_t* first = wall_nbr_.data() + wall_start_[b];
-      std::uint32_t* last = wall_nbr_.data() + wall_start_[b + 1];
-      std::sort(first, last);
-      if (cfg_.wall_model == WallModel::Dynamic) {
-        // A fluid particle held at rest: summation density (its fixed wall part, then the fluid in
-        // ascending index) and the fluid's EOS, never below 0: the outer layers lack neighbours beyond
-        // them, and an unclamped EOS would make them pull the fluid in. Any p_w(rho_w) is the derivative
-        // of a wall energy (here the clamped EOS's), so the forces stay conservative.
-        Real rho = wall_self_rho_[b];
-        for (const std::uint32_t* it = first; it != last; ++it)
-          rho += density_term(w, p_.m[*it], distance2(p_.x[b], p_.x[*it]));
-        const Real pw = std::max(Real(0), cfg_.eos.pressure(rho, rho0_[b]));
-        p_.p[b] = pw;
-        p_.rho[b] = rho;
-        vol_[b] = p_.m[b] / rho;
-        prho2_[b] = pw / (rho * rho);
-        wall_v_[b] = p_.v[b];
-        return;
-      }
-      Real wsum = 0, psum = 0;
-      V rsum{}, vsum{};
-      for (const std::uint32_t* it = first; it != last; ++it) {
-        const std::uint32_t f = *it;
-        const V xwf = p_.x[b] - p_.x[f];
-        const Real wwf = w.W2(norm2(xwf));
-        wsum += wwf;
-        psum += p_.p[f] * wwf;
-        rsum += xwf * (p_.rho[f] * wwf);
-        vsum += p_.v[f] * wwf;
-      }
-      // A wall particle no fluid particle reaches is read by no force; it keeps rest values.
-      Real pw = wsum > 0 ? (psum + dot(cfg_.gravity, rsum)) / wsum : Real(0);
-      if (cfg_.eos.clamp_negative && pw < 0) pw = 0;
-      const Real rhow = cfg_.eos.density(pw, rho0_[b]);
-      p_.p[b] = pw;
-      p_.rho[b] = rhow;
-      vol_[b] = p_.m[b] / rhow;
-      prho2_[b] = pw / (rhow * rhow);
-      wall_v_[b] = wsum > 0 ? p_.v[b] * Real(2) - vsum / wsum : V{};
-    });
-  });
+  wall_v_.resize(p_.size());
+  gather_wall_neighbors(view(), fluid_, boundary_, walls_);
+  if (cfg_.wall_model == WallModel::Dynamic)
+    dynamic_wall_states(cfg_, view(), boundary_);
+  else
+    adami2012_wall_states(cfg_, view(), boundary_);
 }
 
-// CSF normals n_i = sum_j V_j (c_j - c_i) grad W_ij: the difference form vanishes exactly inside a phase.
-// Walls take the colour of the fluid particle, so they contribute nothing.
+// CSF (or Akinci 2013) colour normals of `set` (models/paper_multiphase.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
   timings_.normal_evals += set.size();
-  const Poly6Kernel<Dim, Real> wc(cfg_.support);
-  // Akinci 2013: the full colour gradient h sum_j V_j grad W_ij (non-zero at a free surface).
-  const bool full = cfg_.tension == TensionModel::Akinci;
   normal_.assign(p_.size(), V{});
-  for_each_of(set, [&](std::size_t i) {
-    V n{};
-    for (const auto* it = in_begin(i); it != in_end(i); ++it) {
-      const std::uint32_t j = *it;
-      if (p_.kind[j] != kFluid) continue;
-      n += wc.gradW(p_.x[i] - p_.x[j]) *
-           (full ? p_.m[j] / p_.rho[j] : p_.m[j] / p_.rho[j] * (p_.color[j] - p_.color[i]));
-    }
-    normal_[i] = full ? n * p_.h[i] : n;
-  });
+  paper_normals(cfg_, view(), set);
 }
 
-// Algorithm 1, lines 2-15: f_i = m_i g + eq. 8a + eq. 8b + eq. 9 (or CSF).
+// Algorithm 1, lines 2-15 (models/paper_multiphase.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const IndexList& normal_set) {
   timings_.force_evals += set.size();
-  const Poly6Kernel<Dim, Real> wc(cfg_.support);
-  const ViscosityKernel<Dim, Real> wv(cfg_.support);
-  const Real lap_self = wc.laplacian(0);
-  const bool csf = any_tension_ && cfg_.tension == TensionModel::Csf;
-  const bool akinci = any_tension_ && cfg_.tension == TensionModel::Akinci;
-  const bool eq9 = any_tension_ && cfg_.tension == TensionModel::Paper;
-  const Real thr2 = cfg_.tension_threshold * cfg_.tension_threshold;
-  const CohesionKernel<Dim, Real> coh(cfg_.support);
-  if (csf || akinci) compute_normals(normal_set);
-  with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wp) {
-    for_each_of(set, [&](std::size_t i) {
-      const Real vol_i = p_.m[i] / p_.rho[i];
-      V f = cfg_.gravity * p_.m[i];
-      // The colour field includes particle i itself (its Laplacian does not vanish at r = 0), so that it
-      // is ~0 inside a uniform phase.
-      ColorField<Dim, Real> cf;
-      cf.lap = vol_i * p_.color[i] * lap_self;
-      PairInput<Dim, Real> in{};
-      in.mi = p_.m[i];
-      in.rhoi = p_.rho[i];
-      in.pi = p_.p[i];
-      in.mui = p_.mu[i];
-      const bool csf_i = csf && norm2(normal_[i]) > thr2 && norm2(normal_[i]) > 0;
-      const V nhat_i = csf_i ? normal_[i] / norm(normal_[i]) : V{};
-      // CSF: kappa = -div(n / |n|) over neighbours with a defined normal, divided by their kernel sum
-      // (Morris 2000): the sum alone takes n_j = n_i for the others (more than one support from the
-      // interface) and underestimated the curvature by 17% (Laplace jump) whatever the resolution.
-      Real kappa = 0, wsum = vol_i * wc.W2(0);
-      const V vel_i = p_.v[i];
-      for (const auto* it = in_begin(i); it != in_end(i); ++it) {
-        const std::uint32_t j = *it;
-        in.xij = p_.x[i] - p_.x[j];
-        in.r = norm(in.xij);
-        if (p_.kind[j] == kFluid) {
-          // averaged_pressure_force and averaged_viscosity_force (eq. 8a, 8b), inlined with the
-          // per-particle volumes of the density pass (same expressions, same order).
-          const Real vv = -vol_i * vol_[j];
-          f += wp.gradW(in.xij) * (vv * (in.pi + p_.p[j]) / 2);
-          f += (vel_i - p_.v[j]) * (vv * (in.mui + p_.mu[j]) / 2 * wv.laplacian(in.r));
-          if (csf_i && norm2(normal_[j]) > thr2 && norm2(normal_[j]) > 0) {
-            const V nhat_j = normal_[j] / norm(normal_[j]);
-            kappa -= vol_[j] * dot(nhat_j - nhat_i, wc.gradW(in.xij));
-            wsum += vol_[j] * wc.W2(in.r * in.r);
-          } else if (eq9) {
-            accumulate_color(cf, in.xij, in.r, vol_[j], p_.color[j], wc);
-          } else if (akinci && p_.phase[j] == p_.phase[i] && in.r > 0) {
-            // Each factor is symmetric in (i, j) and x_ij, n_i - n_j antisymmetric: the pair's forces
-            // on i and j are exact opposites.
-            const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-            const Real k = (rho0_[i] + rho0_[j]) / (in.rhoi + p_.rho[j]);
-            f += (in.xij * (-ph.sigma * in.mi * p_.m[j] * coh.C(in.r) / in.r) +
-                  (normal_[i] - normal_[j]) * (-ph.sigma * (in.mi + p_.m[j]) / 2)) *
-                 k;
-          }
-        } else {
-          // A boundary particle acts as fluid with i's density (mirrored, so that its volume psi_b / rho_i
-          // matches how i sees fluid neighbours; with rho0 instead a resting fluid is pushed off the
-          // walls), i's pressure extrapolated to it (see mirrored_boundary_pressure) and i's colour (walls
-          // are neutral to interface tension). No slip: eq. 8b against a particle at rest with i's mu.
-          in.mj = p_.m[j];
-          if (wall_states_) {
-            // Adami: eq. 8a and 8b as between two fluid particles, with the wall's own pressure and
-            // volume psi_b / rho_w (compute_wall_states) and its extrapolated velocity; i's mu.
-            const Real vv = -vol_i * vol_[j];
-            f += wp.gradW(in.xij) * (vv * (in.pi + p_.p[j]) / 2);
-            if (cfg_.no_slip) f += (vel_i - wall_v_[j]) * (vv * in.mui * wv.laplacian(in.r));
-          } else {
-            in.rhoj = in.rhoi;
-            in.pj = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
-            if (cfg_.eos.clamp_negative && in.pj < 0) in.pj = 0;
-            f += averaged_pressure_force(in, wp);
-            if (cfg_.no_slip) f += vel_i * (-vol_i * (in.mj / in.rhoi) * in.mui * wv.laplacian(in.r));
-          }
-          if (eq9) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, p_.color[i], wc);
-        }
-      }
-      if (csf_i) {
-        const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-        f += normal_[i] * (ph.sigma * kappa / wsum * vol_i);
-      } else if (eq9) {
-        // Eq. 9 has the units of a force density (sigma [N/m] times a curvature of C [1/m^2]); by the
-        // paper's own eq. 6 the particle's force is V_i times it. Taken literally as a force it gives
-        // accelerations ~1e5 m/s^2 for the paper's sigma, m and h.
-        const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-        f += interface_tension_force(cf, ph.sigma, cfg_.tension_threshold) * vol_i;
-      }
-      p_.f[i] = f;
-    });
-  });
+  const auto tension = PaperTension::of(cfg_, any_tension_);
+  if (tension.needs_normals()) compute_normals(normal_set);
+  paper_forces(cfg_, view(), set, tension, wall_states_);
 }
 
-// The write-up's loop: non-pressure forces (Monaghan viscosity, gravity, Mueller surface tension) and the
-// symmetric pressure force, kept apart so that the integrator can apply them in two sub-steps.
+// The write-up's forces (models/wcsph.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_forces_wcsph() {
-  const Poly6Kernel<Dim, Real> wc(cfg_.support);
-  const Real lap_self = wc.laplacian(0);
-  const Real h = cfg_.support;
-  const Real eps2 = Real(0.01) * h * h;     // Monaghan's r^2 regulariser
-  const Real visc_c = Real(2 * (Dim + 2));  // 2 (d + 2)
   timings_.force_evals += fluid_.size();
-  with_kernel<Dim, Real>(cfg_.pressure_kernel, cfg_.support, [&](const auto wg) {
-    for_fluid([&](std::size_t i) {
-      const Real vol_i = p_.m[i] / p_.rho[i];
-      V fnp = cfg_.gravity * p_.m[i];
-      V fp{};
-      ColorField<Dim, Real> cf;
-      cf.lap = vol_i * lap_self;
-      PairInput<Dim, Real> in{};
-      in.mi = p_.m[i];
-      in.rhoi = p_.rho[i];
-      in.pi = p_.p[i];
-      in.mui = p_.mu[i];
-      const V vel_i = p_.v[i];
-      const Real prho2_i = prho2_[i];
-      for (const auto* it = in_begin(i); it != in_end(i); ++it) {
-        const std::uint32_t j = *it;
-        in.xij = p_.x[i] - p_.x[j];
-        in.r = norm(in.xij);
-        if (p_.kind[j] == kFluid) {
-          // monaghan_viscosity_force and symmetric_pressure_force, inlined with one kernel gradient
-          // and the per-particle quotients of the density pass (same expressions, same order).
-          const V g = wg.gradW(in.xij);
-          const Real q = dot(vel_i - p_.v[j], in.xij) / (in.r * in.r + eps2);
-          fnp += g * (visc_c * (in.mui + p_.mu[j]) / 2 * vol_i * vol_[j] * q);
-          fp += g * (-in.mi * p_.m[j] * (prho2_i + prho2_[j]));
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, vol_[j], Real(1), wc);
-        } else if (wall_states_) {
-          // Adami: the fluid pair terms with the wall's pressure, density and extrapolated velocity
-          // (compute_wall_states); the viscosity takes i's mu.
-          const V g = wg.gradW(in.xij);
-          fp += g * (-in.mi * p_.m[j] * (prho2_i + prho2_[j]));
-          if (cfg_.no_slip) {
-            const Real q = dot(vel_i - wall_v_[j], in.xij) / (in.r * in.r + eps2);
-            fnp += g * (visc_c * in.mui * vol_i * vol_[j] * q);
-          }
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, Real(1), wc);
-        } else {
-          Real pb = mirrored_boundary_pressure(in.pi, in.rhoi, cfg_.gravity, in.xij);
-          if (cfg_.eos.clamp_negative && pb < 0) pb = 0;
-          const V g = wg.gradW(in.xij);  // shared by the pressure and the no-slip term
-          fp += boundary_pressure_force(g, in.mi, in.rhoi, in.pi, pb, p_.m[j]);
-          if (cfg_.no_slip) {
-            // Monaghan's operator against a particle at rest with volume psi_b / rho_i and i's mu.
-            const Real q = dot(vel_i, in.xij) / (in.r * in.r + eps2);
-            fnp += g * (visc_c * in.mui * vol_i * (p_.m[j] / in.rhoi) * q);
-          }
-          if (any_tension_) accumulate_color(cf, in.xij, in.r, p_.m[j] / in.rhoi, Real(1), wc);
-        }
-      }
-      if (any_tension_) {
-        // Mueller 2003 gives a force density; the particle's share is V_i times it.
-        const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-        fnp += interface_tension_force(cf, ph.sigma, cfg_.tension_threshold) * vol_i;
-      }
-      p_.f[i] = fnp;
-      f_pressure_[i] = fp;
-    });
-  });
+  wcsph_forces(cfg_, view(), fluid_, any_tension_, wall_states_);
 }
 
-// Fixed, or the global Courant step: eq. 12 (alpha h / c and alpha h / |v|), the viscous limit
-// viscous * h^2 / nu and the force limit force * sqrt(h / |a|), capped at dt_max.
+// Fixed, or the global Courant step (timestep/global_courant.hpp).
 template <int Dim, class Real>
-Real Simulation<Dim, Real>::choose_dt() const {
-  if (cfg_.time.mode == TimeStepping::Fixed) return cfg_.time.dt;
-  const Real h = cfg_.support;
-  const Real alpha = cfg_.time.courant;
-  Real dt = cfg_.time.dt_max;
-  Real rho0_min = std::numeric_limits<Real>::max(), nu_max = 0;
-  for (const auto& ph : cfg_.phases) {
-    rho0_min = std::min(rho0_min, ph.rest_density);
-    nu_max = std::max(nu_max, ph.viscosity / ph.rest_density);
-  }
-  dt = std::min(dt, alpha * h / cfg_.eos.sound_speed(rho0_min));
-  if (nu_max > 0) dt = std::min(dt, cfg_.time.viscous * h * h / nu_max);
-  Real v2 = 0, a2 = 0;
-  const bool wcsph = cfg_.model == Model::Wcsph;
-  // A maximum does not depend on the order of evaluation: parallel and still deterministic.
-  const auto count = static_cast<std::int64_t>(fluid_.size());
-#pragma omp parallel for schedule(static) reduction(max : v2, a2)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const std::size_t i = fluid_[static_cast<std::size_t>(k)];
-    v2 = std::max(v2, norm2(p_.v[i]));
-    const V f = wcsph ? p_.f[i] + f_pressure_[i] : p_.f[i];
-    a2 = std::max(a2, norm2(f) / (p_.m[i] * p_.m[i]));
-  }
-  if (v2 > 0) dt = std::min(dt, alpha * h / std::sqrt(v2));
-  if (a2 > 0) dt = std::min(dt, cfg_.time.force * std::sqrt(h / std::sqrt(a2)));
-  return dt;
+Real Simulation<Dim, Real>::choose_dt() {
+  return global_courant_dt(cfg_, view(), fluid_);
 }
 
-// Leap-frog (eq. 11). On the first step v(t0) becomes v(t0 - dt/2) = v(t0) - dt/2 a(t0), so that the
-// kick below lands on v(t0 + dt/2). With a changing step the kick uses the mean of the old and new step,
-// which keeps the velocity at the midpoints of the position steps.
+// Leap-frog (eq. 11, models/paper_multiphase.hpp). On the first step v(t0) becomes v(t0 + dt/2); with a
+// changing step the kick uses the mean of the old and new step.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::integrate_paper(Real dt) {
   const Real kick = leapfrog_started_ ? (last_dt_ + dt) / 2 : dt / 2;
-  for_fluid([&](std::size_t i) {
-    p_.v[i] += p_.f[i] * (kick / p_.m[i]);
-    p_.x[i] += p_.v[i] * dt;
-  });
+  run_pass(fluid_, PaperLeapFrogPass<Dim, Real>{view(), kick, dt});
   leapfrog_started_ = true;
 }
 
-// The write-up's split: v* = v + dt (F_visc + F_ext)/m, then v(t+dt) = v* + dt F_press/m,
-// x(t+dt) = x + dt v(t+dt) (symplectic Euler).
+// The write-up's split with symplectic Euler (models/wcsph.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::integrate_wcsph(Real dt) {
-  for_fluid([&](std::size_t i) {
-    const V vstar = p_.v[i] + p_.f[i] * (dt / p_.m[i]);
-    p_.v[i] = vstar + f_pressure_[i] * (dt / p_.m[i]);
-    p_.x[i] += p_.v[i] * dt;
-    p_.f[i] += f_pressure_[i];  // the total force, for output and the force limit of the next step
-  });
+  run_pass(fluid_, WcsphSymplecticEulerPass<Dim, Real>{view(), dt});
 }
 
+// The box and the planes (integration/collisions.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::apply_walls() {
   if (!cfg_.box.enabled && cfg_.planes.empty()) return;
-  for_fluid([&](std::size_t i) {
-    if (cfg_.box.enabled)
-      box_collision(p_.x[i], p_.v[i], cfg_.box.lo, cfg_.box.hi, cfg_.box.radius, cfg_.box.damping);
-    for (const auto& pl : cfg_.planes)
-      plane_collision(p_.x[i], p_.v[i], pl.normal, pl.offset, cfg_.restitution, cfg_.friction);
-  });
+  run_pass(fluid_, box_plane_collisions(cfg_, view()));
 }
 
 // After each step: the first particle (lowest index) with a non-finite quantity or outside the domain
 // stops the run with a diagnosis.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::check_state() const {
+void Simulation<Dim, Real>::check_state() {
   V lo{}, hi{};
   bool escape = false;
   if (cfg_.domain_set) {
@@ -688,22 +389,9 @@ void Simulation<Dim, Real>::check_state() const {
     escape = true;
   }
   const Real margin = cfg_.support;
-  auto bad = [&](std::size_t i) {
-    if (!all_finite(p_.x[i]) || !all_finite(p_.v[i]) || !all_finite(p_.f[i])) return true;
-    if (!std::isfinite(p_.rho[i]) || !std::isfinite(p_.p[i])) return true;
-    if (escape)
-      for (int a = 0; a < Dim; ++a)
-        if (p_.x[i][a] < lo[a] - margin || p_.x[i][a] > hi[a] + margin) return true;
-    return false;
-  };
-  std::int64_t first = std::numeric_limits<std::int64_t>::max();
-  const auto count = static_cast<std::int64_t>(fluid_.size());
-#pragma omp parallel for schedule(static) reduction(min : first)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const std::uint32_t i = fluid_[static_cast<std::size_t>(k)];
-    if (bad(i)) first = std::min(first, static_cast<std::int64_t>(i));
-  }
-  if (first == std::numeric_limits<std::int64_t>::max()) return;
+  const std::int64_t first =
+      first_where(fluid_, StabilityCheckPass<Dim, Real>{view(), escape, lo, hi, margin});
+  if (first < 0) return;
 
   const auto i = static_cast<std::size_t>(first);
   std::ostringstream os;
@@ -735,86 +423,14 @@ void Simulation<Dim, Real>::check_state() const {
   throw SimulationError(os.str());
 }
 
-// Eq. 12 for one particle, with the same viscous and force limits as the global step.
-template <int Dim, class Real>
-Real Simulation<Dim, Real>::particle_dt(std::size_t i) const {
-  const Real h = cfg_.support, alpha = cfg_.time.courant;
-  const auto& ph = cfg_.phases[static_cast<std::size_t>(p_.phase[i])];
-  Real dt = std::min(cfg_.time.dt_max, alpha * h / cfg_.eos.sound_speed(ph.rest_density));
-  if (ph.viscosity > 0) dt = std::min(dt, cfg_.time.viscous * h * h * ph.rest_density / ph.viscosity);
-  const Real v = norm(p_.v[i]);
-  if (v > 0) dt = std::min(dt, alpha * h / v);
-  const Real a = norm(p_.f[i]) / p_.m[i];
-  if (a > 0) dt = std::min(dt, cfg_.time.force * std::sqrt(h / a));
-  return dt;
-}
-
-// Per-particle steps: the forces of a due particle i read, for every fluid neighbour j within h_i, its
-// density, pressure and volume (eq. 8a-c) and, with CSF, its normal, which reads the densities of j's own
-// neighbours. Densities are therefore needed on due + N(due) (+ N(N(due)) with CSF), normals on
-// due + N(due); anything more would be computed and never read. Marks only ever set bits, so the sets do
-// not depend on the order in which threads mark them.
-template <int Dim, class Real>
-void Simulation<Dim, Real>::build_work_sets() {
-  // CSF and Akinci read the normals of neighbours, which read the densities of theirs.
-  const bool csf =
-      any_tension_ && (cfg_.tension == TensionModel::Csf || cfg_.tension == TensionModel::Akinci);
-  // When every particle is due (often: a uniform limit such as alpha h / c binds them all), the sets are
-  // the whole fluid and the marking pass would be pure overhead.
-  if (full_passes_ || due_list_.size() == fluid_.size()) {
-    rho_set_ = fluid_;
-    normal_set_ = csf ? fluid_ : IndexList{};
-    return;
-  }
-  constexpr std::uint8_t kRho = 1, kNormal = 2;
-  mark_.assign(p_.size(), 0);
-  auto mark_around = [&](const IndexList& from, std::uint8_t bits) {
-    for_each_of(from, [&](std::size_t i) {
-      std::atomic_ref<std::uint8_t>(mark_[i]).fetch_or(bits, std::memory_order_relaxed);
-      const V xi = p_.x[i];
-      const Real hi2 = p_.h[i] * p_.h[i];
-      for (const auto* it = nl_.begin(i); it != nl_.end(i); ++it) {
-        const std::uint32_t j = *it;
-        if (p_.kind[j] != kFluid || distance2(xi, p_.x[j]) > hi2) continue;  // the passes' own test
-        std::atomic_ref<std::uint8_t>(mark_[j]).fetch_or(bits, std::memory_order_relaxed);
-      }
-    });
-  };
-  auto collect = [&](IndexList& out, std::uint8_t bit) {
-    out.clear();
-    for (const std::uint32_t i : fluid_)
-      if (mark_[i] & bit) out.push_back(i);
-  };
-  if (csf) {
-    mark_around(due_list_, static_cast<std::uint8_t>(kRho | kNormal));
-    collect(normal_set_, kNormal);
-    mark_around(normal_set_, kRho);
-  } else {
-    mark_around(due_list_, kRho);
-    normal_set_.clear();
-  }
-  collect(rho_set_, kRho);
-}
-
-// Per-particle power-of-two steps (Desbrun 1996; paper eq. 12-13). Times are integer ticks of
-// dt_max / 2^max_level, so "is particle i due" is an exact comparison. Each step:
-//  1. the global clock T is the smallest particle time; particles with tick == T are due;
-//  2. every position is extrapolated to T (x_j + (T - t_j) v_j) and the neighbour lists kept up to date
-//     for all; forces are evaluated for the due particles only, densities (and CSF normals) only where
-//     those forces read them (build_work_sets), so a sub-step costs in proportion to the particles it
-//     advances;
-//  3. a due particle picks its level from eq. 12 (coarsening only onto a multiple of the coarser step),
-//     gets the position correction of a step change, then the leap-frog kick and drift of Algorithm 1.
-// Step change: the stored v = v(t - dt_old/2) must become v(t + dt_new/2) = v + a (dt_old + dt_new)/2
-// (Exact). Algorithm 1's kick v += a dt_new leaves the velocity off by a (dt_new - dt_old)/2, and a position
-// correction alone (eq. 13) cannot undo a velocity error that persists in all later steps; eq. 13 as
-// printed is offered as Printed, and the single-particle test measures its error.
+// Per-particle power-of-two steps (timestep/per_particle_levels.hpp): the clock T is the smallest
+// particle time; the due particles' forces are evaluated with every position extrapolated to T, then
+// each due particle picks its level and is kicked and drifted.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step_per_particle() {
   const int L = cfg_.time.max_level;
   const Real unit = cfg_.time.dt_max / static_cast<Real>(std::int64_t{1} << L);
-  std::int64_t T = std::numeric_limits<std::int64_t>::max();
-  for (const std::uint32_t i : fluid_) T = std::min(T, p_.tick[i]);
+  std::int64_t T = earliest_tick(view(), fluid_);
   if (T == std::numeric_limits<std::int64_t>::max()) T = 0;
 
   Stopwatch sw;
@@ -829,18 +445,17 @@ void Simulation<Dim, Real>::step_per_particle() {
     sw.reset();
   }
   due_list_.clear();
+  for (const std::uint32_t i : fluid_)
+    if (p_.tick[i] == T) due_list_.push_back(i);
   xs_ = p_.x;
-  for (const std::uint32_t i : fluid_) {
-    if (p_.tick[i] == T)
-      due_list_.push_back(i);
-    else
-      xs_[i] += p_.v[i] * (static_cast<Real>(T - p_.tick[i]) * unit);
-  }
+  run_pass(fluid_, ExtrapolatePass<Dim, Real>{view(), xs_.data(), T, unit});
   std::swap(p_.x, xs_);  // the force passes see positions at time T
   compute_neighbors();
   timings_.neighbors += sw.ms();
   sw.reset();
-  build_work_sets();
+  // CSF and Akinci read the normals of neighbours, which read the densities of theirs.
+  const bool normals = PaperTension::of(cfg_, any_tension_).needs_normals();
+  build_work_sets(view(), fluid_, due_list_, normals, full_passes_, mark_, normal_set_, rho_set_);
   filter_lists(rho_set_);  // every pass below reads rows of rho_set_ only (it holds the other sets)
   compute_density_pressure(rho_set_);
   compute_forces_paper(due_list_, normal_set_);
@@ -848,35 +463,11 @@ void Simulation<Dim, Real>::step_per_particle() {
   timings_.forces += sw.ms();
 
   sw.reset();
-  const bool started = leapfrog_started_;
-  const auto corr = cfg_.time.correction;
-  for_each_of(due_list_, [&](std::size_t i) {
-    int level = 0;
-    const Real want = particle_dt(i);
-    while (level < L && cfg_.time.dt_max / static_cast<Real>(std::int64_t{1} << level) > want) ++level;
-    const int old = p_.level[i];
-    // A coarser step must start on a multiple of itself, so that particles stay synchronised.
-    while (level < old && T % (std::int64_t{1} << (L - level)) != 0) ++level;
-    const Real dt_new = static_cast<Real>(std::int64_t{1} << (L - level)) * unit;
-    const Real dt_old = static_cast<Real>(std::int64_t{1} << (L - old)) * unit;
-    const V a = p_.f[i] / p_.m[i];
-    if (!started) {
-      p_.v[i] += a * (dt_new / 2);  // from v(t0) straight to v(t0 + dt/2) (eq. 11 initialisation)
-    } else if (corr == StepChangeCorrection::Exact) {
-      p_.v[i] += a * ((dt_old + dt_new) / 2);
-    } else {
-      if (level != old) p_.x[i] += a * ((dt_new * dt_new - dt_old * dt_old) / 8);
-      p_.v[i] += a * dt_new;
-    }
-    p_.x[i] += p_.v[i] * dt_new;
-    p_.level[i] = level;
-    p_.tick[i] = T + (std::int64_t{1} << (L - level));
-  });
+  per_particle_levels(cfg_, view(), due_list_, T, leapfrog_started_);
   leapfrog_started_ = true;
   apply_walls();
   check_state();
-  std::int64_t next = std::numeric_limits<std::int64_t>::max();
-  for (const std::uint32_t i : fluid_) next = std::min(next, p_.tick[i]);
+  std::int64_t next = earliest_tick(view(), fluid_);
   if (next == std::numeric_limits<std::int64_t>::max()) next = T + (std::int64_t{1} << L);
   last_dt_ = static_cast<Real>(next - T) * unit;
   time_ = static_cast<Real>(next) * unit;

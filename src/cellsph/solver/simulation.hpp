@@ -27,8 +27,11 @@
 
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
+#include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/config.hpp"
+#include "cellsph/solver/particle_view.hpp"
 #include "cellsph/solver/particles.hpp"
+#include "cellsph/solver/pass_driver.hpp"
 
 namespace cellsph {
 
@@ -115,37 +118,33 @@ class Simulation {
   void set_full_passes(bool on) { full_passes_ = on; }
 
  private:
+  // The plain view of every per-particle array the passes read (particle_view.hpp). Built afresh for each
+  // pass: it holds the arrays' current addresses, which change when an array is resized or swapped.
+  ParticleView<Dim, Real> view();
   // boundary_rows: also the rows of boundary particles (their weights need them); a step needs only
   // fluid rows, so boundary particles are then searched with support 0.
   void compute_neighbors(bool boundary_rows = false);
-  [[nodiscard]] const std::uint32_t* in_begin(std::size_t i) const { return within_.data() + nl_.offsets[i]; }
-  [[nodiscard]] const std::uint32_t* in_end(std::size_t i) const { return in_begin(i) + within_count_[i]; }
-  using IndexList = std::vector<std::uint32_t>;
-  // The pairs of the rows of `set` within h (the Verlet lists hold h + skin): in_begin(i) .. in_end(i).
+  using IndexList = IndexSet;
+  // The pairs of the rows of `set` within h (the Verlet lists hold h + skin): view().row_begin(i) ..
+  // row_end(i).
   void filter_lists(const IndexList& set);
-  template <class F>
-  void for_fluid(F&& f) const;
-  template <class F>
-  void for_each_of(const IndexList& set, F&& f) const;
-  // The passes run over a set of fluid particles (ascending indices): fluid_ for a global step.
+  // The passes run over a set of fluid particles (ascending indices): fluid_ for a global step. Each runs
+  // the pass of the file named in its definition through the driver (pass_driver.hpp).
   void compute_density_pressure(const IndexList& set);
   // normal_set: the particles whose CSF normals the forces of `set` read.
   void compute_forces_paper(const IndexList& set, const IndexList& normal_set);
   void compute_normals(const IndexList& set);
-  // Per-particle steps: from due_list_, the particles whose normals and densities the forces read.
-  void build_work_sets();
   void compute_forces_wcsph();
-  // Adami et al. 2012 walls: pressure, density and no-slip velocity of every boundary particle from its
-  // fluid neighbours, after the density pass.
+  // Adami et al. 2012 and dynamic walls: pressure, density and no-slip velocity of every boundary
+  // particle from its fluid neighbours, after the density pass.
   void compute_wall_states();
-  Real choose_dt() const;
+  Real choose_dt();
   void integrate_paper(Real dt);
   void integrate_wcsph(Real dt);
   void apply_walls();
-  void check_state() const;
+  void check_state();
   void init_boundary_weights();
   void step_per_particle();
-  Real particle_dt(std::size_t i) const;
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
   // ties by id; every per-particle array is permuted and the Verlet lists invalidated.
   void reorder_slots(const IndexList& slots);
@@ -159,6 +158,7 @@ class Simulation {
   std::vector<V> normal_;      // CSF: colour gradient n_i of the current step
   std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
   std::vector<Real> rho0_;     // rest density per particle (from its phase)
+  std::vector<PhaseParams<Real>> phase_params_;  // cfg_.phases as the passes read them
   // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair
   // (the same expressions as before, so the values are bit for bit those computed per pair).
   std::vector<Real> vol_;    // V_j = m_j / rho_j
@@ -171,11 +171,10 @@ class Simulation {
   bool full_passes_ = false;
   // Indices of the boundary particles, ascending; fixed for a simulation like fluid_ (set with it).
   IndexList boundary_;
-  // Adami walls, rebuilt every step (nothing kept across steps, so the particle arrays may be reordered):
-  // the fluid neighbours of each boundary particle (CSR by particle index, ascending within a row:
-  // wall_start_[b] .. wall_start_[b + 1] into wall_nbr_, gathered from the fluid rows) and the
+  // Adami and dynamic walls, rebuilt every step (nothing kept across steps, so the particle arrays may be
+  // reordered): the fluid neighbours of each boundary particle (boundary/wall_neighbors.hpp) and the
   // extrapolated wall velocity of the no-slip term.
-  std::vector<std::uint32_t> wall_start_, wall_nbr_, wall_cursor_;
+  WallNeighbors walls_;
   std::vector<V> wall_v_;
   // WallModel::Dynamic: sum_c m_c W_wc over the wall particles c within h of wall w (w itself included),
   // the constant part of w's summation density (walls never move); 0 for fluid slots.

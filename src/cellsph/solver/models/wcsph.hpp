@@ -1,0 +1,117 @@
+#pragma once
+// The CUDA write-up's weakly compressible SPH (Model::Wcsph):
+//  * density: summation_density.hpp (mass density, then the equation of state);
+//  * forces, kept apart so that the integrator can apply them in two sub-steps: the non-pressure forces
+//    (Monaghan viscosity, gravity, Mueller 2003 surface tension) in f, the symmetric pressure force in
+//    f_pressure: WcsphForcesPass;
+//  * operator splitting with symplectic Euler: WcsphSymplecticEulerPass.
+// The pair formulas are in physics/interactions.hpp; wall particles enter as the boundary model says
+// (boundary/).
+#include <cstddef>
+#include <type_traits>
+
+#include "cellsph/core/hd.hpp"
+#include "cellsph/physics/interactions.hpp"
+#include "cellsph/physics/kernels.hpp"
+#include "cellsph/solver/boundary/akinci2012.hpp"
+#include "cellsph/solver/config.hpp"
+#include "cellsph/solver/particle_view.hpp"
+#include "cellsph/solver/pass_driver.hpp"
+
+namespace cellsph {
+
+template <int Dim, class Real, class GradKernel>
+struct WcsphForcesPass {
+  ParticleView<Dim, Real> pv;
+  GradKernel wg;  // the pressure kernel: its gradient serves pressure and viscosity
+  Poly6Kernel<Dim, Real> wc;
+  Vec<Dim, Real> gravity;
+  Real lap_self;  // wc.laplacian(0)
+  Real eps2;      // Monaghan's r^2 regulariser 0.01 h^2
+  Real tension_threshold;
+  bool any_tension;  // some phase has sigma > 0
+  bool wall_states;  // Adami or dynamic walls: wall particles carry p, rho, vol, prho2 and wall_v
+  bool no_slip;
+  bool clamp_negative;  // the EOS's, for Akinci walls' mirrored pressure
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    using V = Vec<Dim, Real>;
+    const Real vol_i = pv.m[i] / pv.rho[i];
+    V fnp = gravity * pv.m[i];
+    V fp{};
+    ColorField<Dim, Real> cf;
+    cf.lap = vol_i * lap_self;
+    const Real mi = pv.m[i], rhoi = pv.rho[i], pi = pv.p[i], mui = pv.mu[i];
+    const V vel_i = pv.v[i];
+    const Real prho2_i = pv.prho2[i];
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+      const std::uint32_t j = *it;
+      const V xij = pv.x[i] - pv.x[j];
+      const Real r = norm(xij);
+      const V g = wg.gradW(xij);  // one kernel gradient per pair, shared by the terms
+      if (pv.is_fluid(j)) {
+        const Real q = monaghan_quotient(vel_i - pv.v[j], xij, r, eps2);
+        fnp += monaghan_viscosity_force(g, vol_i, pv.vol[j], mui, pv.mu[j], q);
+        fp += symmetric_pressure_force(g, mi, pv.m[j], prho2_i, pv.prho2[j]);
+        if (any_tension) accumulate_color(cf, xij, r, pv.vol[j], Real(1), wc);
+      } else if (wall_states) {
+        // Adami / dynamic walls: the fluid pair terms with the wall's pressure, density and velocity
+        // (boundary/adami2012.hpp, boundary/dynamic_crespo2007.hpp); the viscosity takes i's mu.
+        fp += symmetric_pressure_force(g, mi, pv.m[j], prho2_i, pv.prho2[j]);
+        if (no_slip) {
+          const Real q = monaghan_quotient(vel_i - pv.wall_v[j], xij, r, eps2);
+          fnp += monaghan_viscosity_force(g, vol_i, pv.vol[j], mui, mui, q);
+        }
+        if (any_tension) accumulate_color(cf, xij, r, pv.m[j] / rhoi, Real(1), wc);
+      } else {
+        // Akinci walls (boundary/akinci2012.hpp): mirrored density, extrapolated pressure; no slip:
+        // Monaghan's operator against a particle at rest with volume psi_b / rho_i and i's mu.
+        const Real pb = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
+        fp += boundary_pressure_force(g, mi, rhoi, pi, pb, pv.m[j]);
+        if (no_slip) {
+          const Real q = monaghan_quotient(vel_i, xij, r, eps2);
+          fnp += monaghan_viscosity_force(g, vol_i, pv.m[j] / rhoi, mui, mui, q);
+        }
+        if (any_tension) accumulate_color(cf, xij, r, pv.m[j] / rhoi, Real(1), wc);
+      }
+    }
+    if (any_tension) {
+      // Mueller 2003 gives a force density; the particle's share is V_i times it.
+      fnp += interface_tension_force(cf, pv.phase_of(i).sigma, tension_threshold) * vol_i;
+    }
+    pv.f[i] = fnp;
+    pv.f_pressure[i] = fp;
+  }
+};
+
+// The write-up's split: v* = v + dt (F_visc + F_ext)/m, then v(t+dt) = v* + dt F_press/m,
+// x(t+dt) = x + dt v(t+dt) (symplectic Euler). f becomes the total force, for output and the force
+// limit of the next step.
+template <int Dim, class Real>
+struct WcsphSymplecticEulerPass {
+  ParticleView<Dim, Real> pv;
+  Real dt;
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    const Vec<Dim, Real> vstar = pv.v[i] + pv.f[i] * (dt / pv.m[i]);
+    pv.v[i] = vstar + pv.f_pressure[i] * (dt / pv.m[i]);
+    pv.x[i] += pv.v[i] * dt;
+    pv.f[i] += pv.f_pressure[i];
+  }
+};
+
+// The forces of `set` (the fluid), after the densities and the wall states.
+template <int Dim, class Real>
+void wcsph_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& set,
+                  bool any_tension, bool wall_states) {
+  const Poly6Kernel<Dim, Real> wc(cfg.support);
+  const Real h = cfg.support;
+  with_kernel<Dim, Real>(cfg.pressure_kernel, cfg.support, [&](const auto wg) {
+    using K = std::remove_cvref_t<decltype(wg)>;
+    run_pass(set, WcsphForcesPass<Dim, Real, K>{pv, wg, wc, cfg.gravity, wc.laplacian(0), Real(0.01) * h * h,
+                                                cfg.tension_threshold, any_tension, wall_states, cfg.no_slip,
+                                                cfg.eos.clamp_negative});
+  });
+}
+
+}  // namespace cellsph

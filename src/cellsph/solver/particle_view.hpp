@@ -1,0 +1,84 @@
+#pragma once
+// What a per-particle pass sees: plain pointers to the particle arrays (Particles and the solver's own
+// per-particle arrays) and to the neighbour rows, with the counts. A pass is a small functor or function
+// marked CELLSPH_HD that takes this view (by value) and an index i and computes particle i's result; the
+// driver (pass_driver.hpp) runs it over a set of indices. The view owns nothing and holds no container,
+// so the same pass can later run on a device over device pointers.
+#include <cstddef>
+#include <cstdint>
+
+#include "cellsph/core/hd.hpp"
+#include "cellsph/core/vec.hpp"
+
+namespace cellsph {
+
+// One phase as the passes need it (the scene's Phase without its name).
+template <class Real>
+struct PhaseParams {
+  Real rest_density;
+  Real viscosity;  // dynamic viscosity mu [Pa s]
+  Real sigma;      // interface tension coefficient
+};
+
+template <int Dim, class Real>
+struct ParticleView {
+  using V = Vec<Dim, Real>;
+  static constexpr std::uint8_t kFluid = 0;     // ParticleKind::Fluid
+  static constexpr std::uint8_t kBoundary = 1;  // ParticleKind::Boundary
+
+  std::size_t n = 0;  // particles (fluid and boundary)
+
+  // Particles<Dim, Real> (particles.hpp).
+  V* x = nullptr;
+  V* v = nullptr;
+  V* f = nullptr;
+  Real* m = nullptr;
+  Real* rho = nullptr;
+  Real* p = nullptr;
+  Real* h = nullptr;
+  Real* color = nullptr;
+  Real* mu = nullptr;
+  const std::int32_t* phase = nullptr;
+  std::int32_t* level = nullptr;
+  std::int64_t* tick = nullptr;
+  const std::uint8_t* kind = nullptr;
+  const std::uint32_t* id = nullptr;
+
+  // The solver's per-particle arrays (Simulation members of the same names).
+  const Real* rho0 = nullptr;     // rest density (from the phase)
+  Real* vol = nullptr;            // V_j = m_j / rho_j, from the density pass
+  Real* prho2 = nullptr;          // p_j / rho_j^2, from the density pass
+  V* normal = nullptr;            // CSF / Akinci 2013 colour normal
+  V* f_pressure = nullptr;        // WCSPH: pressure force, applied after the predicted velocity
+  V* wall_v = nullptr;            // Adami: extrapolated no-slip velocity of a wall particle
+  Real* wall_self_rho = nullptr;  // dynamic walls: the fixed wall-wall part of the density
+
+  // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +
+  // 1]. The rows cut to h (filter_rows): within + offsets[i], within_count[i] long; the pair passes read
+  // these.
+  const std::uint64_t* offsets = nullptr;
+  const std::uint32_t* candidates = nullptr;
+  std::uint32_t* within = nullptr;
+  std::uint32_t* within_count = nullptr;
+
+  // Wall particles' fluid neighbours (Adami and dynamic walls, boundary/wall_neighbors.hpp): CSR by particle
+  // index, wall_nbr + wall_start[b] .. wall_nbr + wall_start[b + 1], ascending within a row.
+  const std::uint32_t* wall_start = nullptr;
+  const std::uint32_t* wall_nbr = nullptr;
+
+  // Phase table.
+  const PhaseParams<Real>* phases = nullptr;
+
+  CELLSPH_HD bool is_fluid(std::size_t j) const { return kind[j] == kFluid; }
+  CELLSPH_HD const std::uint32_t* row_begin(std::size_t i) const { return within + offsets[i]; }
+  CELLSPH_HD const std::uint32_t* row_end(std::size_t i) const {
+    return within + offsets[i] + within_count[i];
+  }
+  CELLSPH_HD const std::uint32_t* candidates_begin(std::size_t i) const { return candidates + offsets[i]; }
+  CELLSPH_HD const std::uint32_t* candidates_end(std::size_t i) const { return candidates + offsets[i + 1]; }
+  CELLSPH_HD const PhaseParams<Real>& phase_of(std::size_t i) const {
+    return phases[static_cast<std::size_t>(phase[i])];
+  }
+};
+
+}  // namespace cellsph

@@ -1,0 +1,67 @@
+#pragma once
+// The driver that runs a per-particle pass (a functor pass(i) over a ParticleView, particle_view.hpp)
+// over a set of particle indices. On the CPU: an OpenMP loop, statically scheduled over the set, so
+// the split (and with it every result) depends only on the thread count. Every pass writes only
+// particle i's own entries (or reduces), so the order in which the indices run does not matter.
+//
+// A GPU backend replaces these functions by kernel launches over the same passes.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "cellsph/core/parallel.hpp"
+
+namespace cellsph {
+
+using IndexSet = std::vector<std::uint32_t>;
+
+// pass(i) for every i in `set` (ascending indices, usually).
+template <class Pass>
+void run_pass(const IndexSet& set, const Pass& pass) {
+  const std::uint32_t* idx = set.data();
+  parallel_for(set.size(), [&](std::size_t k) { pass(static_cast<std::size_t>(idx[k])); });
+}
+
+// pass(i) for every i in [0, n).
+template <class Pass>
+void run_pass(std::size_t n, const Pass& pass) {
+  parallel_for(n, [&](std::size_t i) { pass(i); });
+}
+
+// The largest pass(i) over `set`, each value a Result with members combined by Result::max_of (a
+// maximum does not depend on the order of evaluation, so the reduction is deterministic). Starts from
+// `init`.
+template <class Result, class Pass>
+Result reduce_max(const IndexSet& set, Result init, const Pass& pass) {
+  std::vector<Result> partial(static_cast<std::size_t>(max_threads()), init);
+  const auto count = static_cast<std::int64_t>(set.size());
+  const std::uint32_t* idx = set.data();
+#pragma omp parallel
+  {
+    Result r = init;
+#pragma omp for schedule(static) nowait
+    for (std::int64_t k = 0; k < count; ++k) r = Result::max_of(r, pass(static_cast<std::size_t>(idx[k])));
+    partial[static_cast<std::size_t>(thread_id())] = r;
+  }
+  Result r = init;
+  for (const Result& q : partial) r = Result::max_of(r, q);
+  return r;
+}
+
+// The lowest index i of `set` with pred(i) true, or -1 if none (deterministic: a minimum).
+template <class Pred>
+std::int64_t first_where(const IndexSet& set, const Pred& pred) {
+  std::int64_t first = std::numeric_limits<std::int64_t>::max();
+  const auto count = static_cast<std::int64_t>(set.size());
+  const std::uint32_t* idx = set.data();
+#pragma omp parallel for schedule(static) reduction(min : first)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const std::uint32_t i = idx[k];
+    if (pred(static_cast<std::size_t>(i))) first = std::min(first, static_cast<std::int64_t>(i));
+  }
+  return first == std::numeric_limits<std::int64_t>::max() ? -1 : first;
+}
+
+}  // namespace cellsph

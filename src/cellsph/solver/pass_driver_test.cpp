@@ -1,0 +1,160 @@
+// The pass driver against sequential loops (every index once, maxima, first matches, for several thread
+// counts), and passes run on a hand-made ParticleView against values written out by hand: a pass needs
+// nothing but the view.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/physics/kernels.hpp"
+#include "cellsph/solver/models/summation_density.hpp"
+#include "cellsph/solver/pass_driver.hpp"
+#include "cellsph/solver/stability_check.hpp"
+#include "cellsph/solver/verlet_rows.hpp"
+
+namespace cellsph {
+namespace {
+
+struct MaxPair {
+  double a = 0, b = 0;
+  static MaxPair max_of(const MaxPair& x, const MaxPair& y) {
+    return {std::max(x.a, y.a), std::max(x.b, y.b)};
+  }
+};
+
+IndexSet random_set(std::mt19937& rng, std::uint32_t n) {
+  IndexSet set;
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (rng() % 3 != 0) set.push_back(i);
+  return set;
+}
+
+TEST(PassDriver, RunPassVisitsEveryIndexOfTheSetOnce) {
+  std::mt19937 rng(7);
+  for (const int threads : {1, 2, 3}) {
+    ScopedThreads st(threads);
+    const IndexSet set = random_set(rng, 1001);
+    std::vector<int> hits(1001, 0);
+    run_pass(set, [&](std::size_t i) { ++hits[i]; });  // each i written by one thread only
+    for (std::uint32_t i = 0; i < 1001; ++i)
+      EXPECT_EQ(hits[i], std::count(set.begin(), set.end(), i) ? 1 : 0) << i;
+    std::vector<int> all(37, 0);
+    run_pass(all.size(), [&](std::size_t i) { all[i] += 2; });
+    EXPECT_EQ(std::count(all.begin(), all.end(), 2), 37);
+  }
+}
+
+TEST(PassDriver, ReduceMaxAndFirstWhereMatchSequentialLoops) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const int threads : {1, 2, 3, 5}) {
+    ScopedThreads st(threads);
+    for (int trial = 0; trial < 20; ++trial) {
+      const IndexSet set = random_set(rng, 500);
+      std::vector<double> va(500), vb(500);
+      for (auto& x : va) x = u(rng);
+      for (auto& x : vb) x = u(rng);
+      MaxPair want;
+      for (const auto i : set) want = {std::max(want.a, va[i]), std::max(want.b, vb[i])};
+      const MaxPair got = reduce_max(set, MaxPair{}, [&](std::size_t i) { return MaxPair{va[i], vb[i]}; });
+      EXPECT_EQ(got.a, want.a);
+      EXPECT_EQ(got.b, want.b);
+
+      const double cut = trial == 0 ? 2.0 : 0.9;  // trial 0: no index qualifies
+      std::int64_t first = -1;
+      for (const auto i : set)
+        if (va[i] > cut) {
+          first = i;
+          break;
+        }
+      EXPECT_EQ(first_where(set, [&](std::size_t i) { return va[i] > cut; }), first);
+    }
+  }
+  EXPECT_EQ(first_where(IndexSet{}, [](std::size_t) { return true; }), -1);
+  EXPECT_EQ(reduce_max(IndexSet{}, MaxPair{-1, -2}, [](std::size_t) { return MaxPair{5, 5}; }).b, -2);
+}
+
+// Three particles on the x axis at 0, 0.3 and 0.9 with h = 1, 1 and 0.5: the candidate rows hold every
+// pair; within h_i: 0 -> {1, 2}, 1 -> {0, 2}, 2 -> {} (0.9 and 0.6 away, beyond its 0.5).
+struct Line {
+  std::vector<Vec<2, double>> x{Vec<2, double>{{0.0, 0.0}}, Vec<2, double>{{0.3, 0.0}},
+                                Vec<2, double>{{0.9, 0.0}}};
+  std::vector<double> m{1.0, 2.0, 4.0}, h{1.0, 1.0, 0.5}, rho{0, 0, 0}, p{0, 0, 0}, vol{0, 0, 0},
+      prho2{0, 0, 0};
+  std::vector<double> rho0{1000, 1000, 1000};
+  std::vector<std::uint8_t> kind{0, 0, 0};
+  std::vector<std::uint64_t> offsets{0, 2, 4, 6};
+  std::vector<std::uint32_t> candidates{1, 2, 0, 2, 0, 1}, within{9, 9, 9, 9, 9, 9}, count{0, 0, 0};
+  ParticleView<2, double> view() {
+    ParticleView<2, double> v;
+    v.n = 3;
+    v.x = x.data();
+    v.m = m.data();
+    v.h = h.data();
+    v.rho = rho.data();
+    v.p = p.data();
+    v.vol = vol.data();
+    v.prho2 = prho2.data();
+    v.rho0 = rho0.data();
+    v.kind = kind.data();
+    v.offsets = offsets.data();
+    v.candidates = candidates.data();
+    v.within = within.data();
+    v.within_count = count.data();
+    return v;
+  }
+};
+
+TEST(Passes, FilterRowsAndSummationDensityOnAHandMadeView) {
+  Line l;
+  const IndexSet all{0, 1, 2};
+  run_pass(all, FilterRowsPass<2, double>{l.view()});
+  EXPECT_EQ(l.count, (std::vector<std::uint32_t>{2, 2, 0}));
+  EXPECT_EQ(l.within[0], 1u);
+  EXPECT_EQ(l.within[1], 2u);
+  EXPECT_EQ(l.within[2], 0u);
+  EXPECT_EQ(l.within[3], 2u);
+
+  EquationOfState<double> eos;
+  eos.kind = EosKind::Linear;
+  eos.stiffness = 10;
+  const Poly6Kernel<2, double> w(1.0);  // the pass's kernel support; rows decide who counts
+  run_pass(all, SummationDensityPass<2, double, Poly6Kernel<2, double>>{l.view(), w, eos, false});
+  const double rho0 = 1 * w.W2(0) + 2 * w.W2(0.09) + 4 * w.W2(0.81);
+  const double rho1 = 2 * w.W2(0) + 1 * w.W2(0.09) + 4 * w.W2(0.36);
+  const double rho2 = 4 * w.W2(0);
+  EXPECT_NEAR(l.rho[0], rho0, 1e-12 * rho0);
+  EXPECT_NEAR(l.rho[1], rho1, 1e-12 * rho1);
+  EXPECT_NEAR(l.rho[2], rho2, 1e-12 * rho2);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(l.p[i], 10 * (l.rho[i] - 1000), 1e-9 * std::abs(l.p[i]) + 1e-9);
+    EXPECT_DOUBLE_EQ(l.vol[i], l.m[i] / l.rho[i]);
+  }
+}
+
+TEST(Passes, StabilityCheckFindsTheFirstBadParticle) {
+  Line l;
+  l.rho = {1, 1, 1};
+  std::vector<Vec<2, double>> v(3), f(3);
+  auto pv = l.view();
+  pv.v = v.data();
+  pv.f = f.data();
+  const IndexSet all{0, 1, 2};
+  const StabilityCheckPass<2, double> inside{pv, true, Vec<2, double>{{0.0, 0.0}}, Vec<2, double>{{1.0, 1.0}},
+                                             0.05};
+  EXPECT_EQ(first_where(all, inside), -1);
+  l.x[2][0] = 1.2;  // beyond hi + margin
+  l.p[1] = std::nan("");
+  EXPECT_EQ(first_where(all, inside), 1);
+  l.p[1] = 0;
+  EXPECT_EQ(first_where(all, inside), 2);
+  const StabilityCheckPass<2, double> no_domain{pv, false, Vec<2, double>{{0.0, 0.0}},
+                                                Vec<2, double>{{1.0, 1.0}}, 0.05};
+  EXPECT_EQ(first_where(all, no_domain), -1);
+}
+
+}  // namespace
+}  // namespace cellsph
