@@ -39,4 +39,7 @@ void write_png(const Image& image, const std::filesystem::path& path);
 // Decodes any PNG to 8-bit RGB. Throws InputError naming the file.
 Image read_png(const std::filesystem::path& path);
 
+// The libpng this build writes with, e.g. "1.6.39" (`cellsph doctor`).
+std::string libpng_version();
+
 }  // namespace cellsph

@@ -343,4 +343,6 @@ CELLSPH_SURFACE_INSTANTIATE(3, float)
 CELLSPH_SURFACE_INSTANTIATE(3, double)
 #undef CELLSPH_SURFACE_INSTANTIATE
 
+std::string openvdb_version() { return openvdb::getLibraryVersionString(); }
+
 }  // namespace cellsph

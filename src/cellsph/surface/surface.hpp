@@ -49,6 +49,9 @@ struct SurfaceOptions {
 // Checks the options; throws InputError naming the option and its value.
 void validate(const SurfaceOptions& opt);
 
+// The OpenVDB library this build meshes with, e.g. "10.0.1" (`cellsph doctor`).
+std::string openvdb_version();
+
 // One extracted mesh, in world coordinates (z = 0 is the 2D plane). Triangles are counter-clockwise
 // seen from outside, and normals (unit, one per vertex) point out of the fluid.
 struct SurfaceMesh {
