@@ -43,18 +43,7 @@ using cellsph::test::TempDir;
 using cellsph::test::write_file;
 namespace fs = std::filesystem;
 
-// 72 particles falling in a box (as in cli_run_test.cpp), a checkpoint after every frame.
-const char* kTiny = R"({
-  "name": "tiny", "description": "test", "dimension": 2, "spacing": 0.05,
-  "phases": [{"name": "water", "rest_density": 1000, "viscosity": 0.5}],
-  "solver": {"model": "wcsph", "support": 0.1, "density_kernel": "cubic", "pressure_kernel": "cubic",
-             "eos": {"kind": "tait", "stiffness": 20000, "gamma": 7, "clamp_negative": true}},
-  "time": {"end": 0.1, "stepping": "courant", "dt_max": 0.002},
-  "neighbors": {"method": "sorted-grid"},
-  "fluids": [{"min": [0, 0], "max": [0.3, 0.6]}],
-  "boundary": {"box": {"min": [0, 0], "max": [1, 1]}},
-  "output": {"fps": 50, "formats": ["vtu", "ply", "csv"], "checkpoint_every": 1}
-})";
+using cellsph::test::kTiny;  // a checkpoint after every frame
 
 // ---- folder snapshots ---------------------------------------------------------------------------------
 

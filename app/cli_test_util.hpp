@@ -87,4 +87,18 @@ inline std::string q(const fs::path& p) {
   return s;
 }
 
+// The CLI tests' scene: 72 particles falling in a box (a run of 0.1 s takes a fraction of a second),
+// frames in every format, a checkpoint after every frame.
+inline constexpr const char* kTiny = R"({
+  "name": "tiny", "description": "test", "dimension": 2, "spacing": 0.05,
+  "phases": [{"name": "water", "rest_density": 1000, "viscosity": 0.5}],
+  "solver": {"model": "wcsph", "support": 0.1, "density_kernel": "cubic", "pressure_kernel": "cubic",
+             "eos": {"kind": "tait", "stiffness": 20000, "gamma": 7, "clamp_negative": true}},
+  "time": {"end": 0.1, "stepping": "courant", "dt_max": 0.002},
+  "neighbors": {"method": "sorted-grid"},
+  "fluids": [{"min": [0, 0], "max": [0.3, 0.6]}],
+  "boundary": {"box": {"min": [0, 0], "max": [1, 1]}},
+  "output": {"fps": 50, "formats": ["vtu", "ply", "csv"], "checkpoint_every": 1}
+})";
+
 }  // namespace cellsph::test
