@@ -15,9 +15,10 @@ if ((${#NAMES[@]} == 0)); then
   for f in fuzz/*_fuzz.cpp; do NAMES+=("$(basename "$f" _fuzz.cpp)"); done
 fi
 
+# Debug: assertions (nlohmann's among them) stay on; fuzz/CMakeLists.txt adds -O1.
 LAUNCHER=()
 command -v ccache >/dev/null && LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ -DCELLSPH_FUZZ=ON \
+cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DCELLSPH_FUZZ=ON \
   "${LAUNCHER[@]}" >/dev/null
 targets=()
 for n in "${NAMES[@]}"; do targets+=("${n}_fuzz"); done

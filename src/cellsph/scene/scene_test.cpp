@@ -159,6 +159,35 @@ TEST(Scene, SyntaxErrorNamesFileLineAndColumn) {
   std::filesystem::remove(path);
 }
 
+// nlohmann's operator[] fills an array up to the index an edit names: /phases/100000000/viscosity=1 once
+// made 10^8 JSON values (1.6 GB) before the strict reader could refuse the scene (found by
+// fuzz/scene_fuzz.cpp, input fuzz/regressions/scene/huge-array-index-in-set). An index may be at most one
+// past the end (it appends, as "-" does), also in an array the edit creates.
+TEST(Scene, EditsCannotGrowAnArrayByMoreThanOne) {
+  const std::pair<std::string, std::string> refused[] = {
+      {"/phases/100000000/viscosity=1",
+       "index 100000000 is beyond the end of /phases (1 elements: the next is 1 or -)"},
+      {"/fluids/2/min=[0,0]", "index 2 is beyond the end of /fluids (1 elements: the next is 1 or -)"},
+      {"/extra/5=1", "index 5 is beyond the end of /extra (0 elements: the next is 0 or -)"},
+      {"/fluids/0/min/44444444444=1", "index 44444444444 is beyond the end of /fluids/0/min (2 elements"}};
+  for (const auto& [edit, what] : refused) {
+    auto j = nlohmann::json::parse(kMinimal);
+    j["phases"] = nlohmann::json::parse(R"([{"name": "water"}])");
+    std::string src = "scene.json";
+    try {
+      apply_scene_edits(j, {edit}, src);
+      FAIL() << "accepted " << edit;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--set '" + edit + "': " + what), std::string::npos) << e.what();
+    }
+  }
+  auto j = nlohmann::json::parse(kMinimal);
+  std::string src = "scene.json";
+  apply_scene_edits(j, {"/fluids/1={\"min\": [1.2, 0], \"max\": [1.6, 0.4]}", "/extra/0=1"}, src);
+  EXPECT_EQ(j["fluids"].size(), 2u);
+  EXPECT_EQ(j["extra"], nlohmann::json::parse("[1]"));
+}
+
 // A number beyond a double is valid JSON text that the parser cannot hold: it once ended in "internal
 // error" (nlohmann's out_of_range 406, not a parse_error); found by fuzz/scene_fuzz.cpp, input
 // fuzz/regressions/scene/number-beyond-double.
