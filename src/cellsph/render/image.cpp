@@ -85,6 +85,8 @@ Image read_png(const std::filesystem::path& path) {
   return img;
 }
 
-std::string libpng_version() { return png_get_libpng_ver(nullptr); }
+std::string libpng_version() {
+  return png_get_libpng_ver(nullptr);
+}
 
 }  // namespace cellsph

@@ -343,6 +343,8 @@ CELLSPH_SURFACE_INSTANTIATE(3, float)
 CELLSPH_SURFACE_INSTANTIATE(3, double)
 #undef CELLSPH_SURFACE_INSTANTIATE
 
-std::string openvdb_version() { return openvdb::getLibraryVersionString(); }
+std::string openvdb_version() {
+  return openvdb::getLibraryVersionString();
+}
 
 }  // namespace cellsph
