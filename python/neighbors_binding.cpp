@@ -76,8 +76,11 @@ std::span<const Vec<Dim, Real>> points_span(const Query& q) {
   return {static_cast<const Vec<Dim, Real>*>(q.points.data()), q.n};
 }
 
+// Builds the search on `threads` threads with the GIL released (the points stay alive in q).
 template <int Dim, class Real>
-void build(NeighborSearch<Dim, Real>& ns, const Query& q) {
+void build(NeighborSearch<Dim, Real>& ns, const Query& q, int threads) {
+  py::gil_scoped_release nogil;
+  ScopedThreads scoped(threads);
   const auto x = points_span<Dim, Real>(q);
   if (q.radius)
     ns.build(x, static_cast<Real>(*q.radius));
@@ -140,11 +143,7 @@ py::tuple neighbors_fn(const py::handle& points, std::optional<double> radius, c
   const Query q = query_args(points, radius, h);
   return dispatch(q, [&]<int Dim, class Real>() {
     NeighborSearch<Dim, Real> ns(opt);
-    {
-      py::gil_scoped_release nogil;
-      ScopedThreads scoped(threads);
-      build(ns, q);
-    }
+    build(ns, q, threads);
     return find_all(ns, q, return_distances, threads);
   });
 }
@@ -156,11 +155,7 @@ py::array count_fn(const py::handle& points, std::optional<double> radius, const
   const Query q = query_args(points, radius, h);
   return dispatch(q, [&]<int Dim, class Real>() {
     NeighborSearch<Dim, Real> ns(opt);
-    {
-      py::gil_scoped_release nogil;
-      ScopedThreads scoped(threads);
-      build(ns, q);
-    }
+    build(ns, q, threads);
     return count(ns, q.n, threads);
   });
 }
@@ -181,10 +176,7 @@ class PyNeighborSearch {
     dispatch(q, [&]<int Dim, class Real>() {
       using NS = NeighborSearch<Dim, Real>;
       if (!std::holds_alternative<NS>(ns_)) ns_.template emplace<NS>(opt_);
-      auto& ns = std::get<NS>(ns_);
-      py::gil_scoped_release nogil;
-      ScopedThreads scoped(threads_);
-      cellsph::python::build(ns, q);
+      cellsph::python::build(std::get<NS>(ns_), q, threads_);
       return 0;
     });
     q_ = std::move(q);
