@@ -228,6 +228,46 @@ TEST(CliRunFailedStart, NewRunLeavesTheOutputLocationAsItWas) {
   EXPECT_TRUE(snapshot(dir / "afile") == before);
 }
 
+// Mesh files are untrusted input too (geometry/mesh.hpp): an open mesh, a missing file, garbage, a
+// truncated binary STL each stop the start with one line naming the scene file, the key and the mesh file.
+TEST(CliRunFailedStart, BadMeshFilesLeaveTheOutputLocationAsItWas) {
+  TempDir dir;
+  const fs::path meshes = fs::path(CELLSPH_SOURCE_DIR) / "data" / "meshes";
+  fs::create_directories(dir / "m");
+  for (const char* f : {"open-cube.obj", "garbage.stl", "truncated.stl", "cube-binary.stl"})
+    fs::copy_file(meshes / f, dir / "m" / f);
+  write_file(dir / "box.json", R"({"name": "box", "dimension": 3, "spacing": 0.1,
+    "time": {"end": 0.01},
+    "fluids": [{"min": [0, 0, 0], "max": [0.5, 0.5, 0.5]}],
+    "boundary": {"obstacles": [{"mesh": "m/cube-binary.stl", "scale": 0.2, "translate": [1, 1, 1]}]}})");
+  const struct {
+    const char* name;
+    const char* mesh;
+    const char* mention;
+  } cases[] = {
+      {"open_mesh", "m/open-cube.obj",
+       "/boundary/obstacles/0/mesh: m/open-cube.obj: is not a closed surface"},
+      {"missing_mesh", "m/nope.stl", "/boundary/obstacles/0/mesh: m/nope.stl: no such file"},
+      {"garbage_mesh", "m/garbage.stl",
+       "/boundary/obstacles/0/mesh: m/garbage.stl: binary STL header announces"},
+      {"truncated_stl", "m/truncated.stl", "/boundary/obstacles/0/mesh: m/truncated.stl: binary STL"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path out = dir / (std::string("out_") + c.name);
+    const auto r = run_cli(dir, "run " + q(dir / "box.json") + " --out " + q(out) +
+                                    " --set /boundary/obstacles/0/mesh=" + c.mesh + " --quiet");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("box.json"), std::string::npos) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // The good mesh runs (paths resolve against the scene file, not the working folder).
+  const auto r = run_cli(dir, "run " + q(dir / "box.json") + " --out " + q(dir / "ok") + " --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST(CliRunFailedStart, ResumeLeavesTheFolderAsItWas) {
   TempDir dir;
   write_file(dir / "tiny.json", kTiny);

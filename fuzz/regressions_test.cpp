@@ -14,6 +14,7 @@
 
 #include "checkpoint_input.hpp"
 #include "frames_index_input.hpp"
+#include "mesh_input.hpp"
 #include "points_csv_input.hpp"
 #include "scene_input.hpp"
 
@@ -28,7 +29,8 @@ struct Harness {
 const Harness kHarnesses[] = {{"scene", scene_input},
                               {"points_csv", points_csv_input},
                               {"checkpoint", checkpoint_input},
-                              {"frames_index", frames_index_input}};
+                              {"frames_index", frames_index_input},
+                              {"mesh", mesh_input}};
 
 class FuzzReplay : public ::testing::TestWithParam<Harness> {};
 

@@ -12,4 +12,12 @@ struct BuiltinScene {
 
 const std::vector<BuiltinScene>& builtin_scenes();
 
+// The meshes of scenes/meshes/ (text formats), which built-in scenes name as "meshes/FILE".
+struct BuiltinMesh {
+  std::string_view name;  // "meshes/FILE"
+  std::string_view data;  // the file's bytes
+};
+
+const std::vector<BuiltinMesh>& builtin_meshes();
+
 }  // namespace cellsph

@@ -9,6 +9,9 @@
 #include <limits>
 #include <string_view>
 
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/geometry/mesh.hpp"
+#include "cellsph/geometry/shape.hpp"
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/scene/json_reader.hpp"
@@ -216,7 +219,7 @@ double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, double spacing) {
 template <int Dim, class Real>
 void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& cfg, double spacing,
                        const std::vector<bool>& mass_given, const std::vector<Aabb<Dim>>& blocks,
-                       const std::vector<std::int32_t>& block_phase) {
+                       const std::vector<std::int32_t>& block_phase, const std::vector<double>& extra) {
   double g2 = 0;
   for (int a = 0; a < Dim; ++a) g2 += double(cfg.gravity[a]) * double(cfg.gravity[a]);
   const double g = std::sqrt(g2);
@@ -227,7 +230,7 @@ void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& c
     if (p.kind[i] != static_cast<std::uint8_t>(ParticleKind::Fluid)) continue;
     std::array<double, Dim> x{};
     for (int a = 0; a < Dim; ++a) x[static_cast<std::size_t>(a)] = double(p.x[i][a]);
-    double pressure = 0;
+    double pressure = extra[i];
     if (g > 0)
       for (std::size_t b = 0; b < blocks.size(); ++b)
         pressure += g * double(cfg.phases[static_cast<std::size_t>(block_phase[b])].rest_density) *
@@ -303,6 +306,15 @@ class ParticleBudget {
     }
     // A support of many spacings makes every particle costly: name that way out too.
     fix_ = radius > 8 ? "use a larger /spacing or a smaller /solver/support" : "use a larger /spacing";
+  }
+
+  // The lattice sites a shape's sampling walks (its bounding box): at most 64 per particle of the limit, so
+  // that a thin shape in a huge box cannot take hours to sample.
+  void take_sites(double sites, const JsonReader& r, const std::string& key, const std::string& what) const {
+    if (sites > 64 * limit_)
+      r.fail(key, "the bounding box of " + what + " spans " + number(sites) + " lattice sites at spacing " +
+                      number(spacing_) + ", more than 64 times the particle limit " + number(limit_) + ": " +
+                      fix_);
   }
 
   // Adds `count` particles made by the object at `key` of `r`; fails there if the total is too many.
@@ -481,7 +493,115 @@ template <int Dim>
 struct Regions {
   std::vector<Aabb<Dim>> solids;       // regions fluid must not overlap
   std::optional<Aabb<Dim>> container;  // region fluid must lie in
+  // Shaped obstacles and containers (boundary.obstacles with "mesh", "sphere" or "cylinder"): fluid
+  // particles keep half a spacing outside every obstacle and inside some container.
+  std::vector<geometry::Shape> solid_shapes, container_shapes;
+  std::vector<std::string> shape_keys;  // key paths of all shapes, for the domain check
+  std::vector<geometry::Shape> all_shapes;
+  std::vector<double> shape_margins;  // how far each shape's particles reach beyond it
 };
+
+// Where a scene's mesh files are: beside the scene file, or compiled in for a built-in scene.
+struct MeshFiles {
+  bool builtin = false;
+  std::filesystem::path dir;
+};
+
+MeshFiles mesh_files_of(const std::string& source) {
+  std::string s = source;
+  if (const auto ed = s.find(" (edited: "); ed != std::string::npos) s.resize(ed);
+  if (s.rfind("built-in scene ", 0) == 0) return {true, {}};
+  return {false, std::filesystem::path(s).parent_path()};
+}
+
+// The shape of an obstacle or fluid volume at `e`: "mesh", "sphere" or "cylinder" (docs/scenes.md,
+// "Shapes"); nothing when it is a box ("min", "max").
+template <int Dim>
+std::optional<geometry::Shape> read_shape(JsonReader& e, double spacing, const MeshFiles& files) {
+  int given = 0;
+  for (const char* k : {"min", "mesh", "sphere", "cylinder"}) given += e.has(k) ? 1 : 0;
+  if (given > 1) e.fail_here("give one shape: \"min\"/\"max\" (a box), \"mesh\", \"sphere\" or \"cylinder\"");
+  if (e.has("sphere")) {
+    auto sr = e.child("sphere");
+    const auto c = sr.required_vector("center", Dim);
+    geometry::Sphere sp;
+    for (std::size_t a = 0; a < Dim; ++a) sp.center[a] = c[a];
+    sp.radius = sr.required_number("radius", 0, 1e9);
+    if (!(sp.radius > 0)) sr.fail("radius", "must be > 0");
+    sr.finish();
+    return geometry::Shape::sphere(sp, Dim);
+  }
+  if (e.has("cylinder")) {
+    auto cr = e.child("cylinder");
+    const auto b = cr.required_vector("base", Dim);
+    const auto ax = cr.required_vector("axis", Dim);
+    geometry::Cylinder cy;
+    double len = 0;
+    for (std::size_t a = 0; a < Dim; ++a) len += ax[a] * ax[a];
+    len = std::sqrt(len);
+    if (!(len > 0) || !std::isfinite(len)) cr.fail("axis", "must be a non-zero vector");
+    for (std::size_t a = 0; a < Dim; ++a) {
+      cy.base[a] = b[a];
+      cy.axis[a] = ax[a] / len;
+    }
+    if (Dim == 2) cy.axis[2] = 0;
+    cy.radius = cr.required_number("radius", 0, 1e9);
+    if (!(cy.radius > 0)) cr.fail("radius", "must be > 0");
+    cy.height = cr.required_number("height", 0, 1e9);
+    if (!(cy.height > 0)) cr.fail("height", "must be > 0");
+    cr.finish();
+    return geometry::Shape::cylinder(cy, Dim);
+  }
+  if (!e.has("mesh")) return std::nullopt;
+  const std::string name = e.string("mesh", "");
+  if (Dim != 3) e.fail("mesh", "meshes need \"dimension\": 3 (in 2D use \"sphere\" or \"cylinder\")");
+  if (name.empty()) e.fail("mesh", "must name a mesh file (.stl, .obj or .ply)");
+  geometry::MeshTransform t;
+  t.scale = e.number("scale", 1, 0, 1e9);
+  if (!(t.scale > 0)) e.fail("scale", "must be > 0");
+  if (e.has("rotate")) {
+    auto rr = e.child("rotate");
+    const auto ax = rr.required_vector("axis", 3);
+    double len = 0;
+    for (std::size_t a = 0; a < 3; ++a) {
+      t.axis[a] = ax[a];
+      len += ax[a] * ax[a];
+    }
+    if (!(len > 0) || !std::isfinite(len)) rr.fail("axis", "must be a non-zero vector");
+    t.angle_deg = rr.required_number("angle", -1e6, 1e6);
+    rr.finish();
+  }
+  const auto tr = e.vector("translate", 3, {0, 0, 0});
+  for (std::size_t a = 0; a < 3; ++a) t.translate[a] = tr[a];
+  geometry::TriangleMesh m;
+  try {
+    if (files.builtin) {
+      const BuiltinMesh* found = nullptr;
+      for (const auto& bm : builtin_meshes())
+        if (bm.name == name) found = &bm;
+      if (!found) throw InputError(name + ": no such mesh among the built-in scenes' (scenes/meshes/)");
+      const auto dot = name.rfind('.');
+      m = geometry::parse_mesh(found->data, dot == std::string::npos ? "" : name.substr(dot + 1), name);
+    } else {
+      const std::filesystem::path p(name);
+      m = geometry::read_mesh_file(p.is_absolute() ? p : files.dir / p, name);
+    }
+    geometry::check_closed(m, name);
+  } catch (const InputError& err) {
+    e.fail("mesh", err.what());
+  }
+  geometry::transform(m, t);
+  return geometry::Shape::mesh(std::move(m), spacing);
+}
+
+// The particles a shape's sampling may make, counted before it runs: its volume (fluid) or a shell of
+// `layers` spacings over its surface (walls), and the lattice it walks.
+template <int Dim>
+void budget_shape(ParticleBudget& budget, const geometry::Shape& s, double spacing, double margin,
+                  double estimate, const JsonReader& r, const std::string& key, const std::string& what) {
+  budget.take(estimate, r, key, what);
+  budget.take_sites(geometry::lattice_sites(s, spacing, margin), r, key, what);
+}
 
 template <int Dim, class Real>
 void read_box_boundary(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regions) {
@@ -552,13 +672,41 @@ void read_walls(JsonReader& br, double spacing, const SolverConfig<Dim, Real>& c
   regions.container = b;
 }
 
+// A shaped obstacle: `layers` layers of boundary particles on the lattice inside its surface, or, with
+// "inside": true (a container), outside it.
 template <int Dim, class Real>
-void read_obstacles(JsonReader& br, double spacing, ParticleBudget& budget, Particles<Dim, Real>& p,
-                    Regions<Dim>& regions) {
+void add_shape_walls(JsonReader& ob, JsonReader& e, std::size_t k, double spacing, ParticleBudget& budget,
+                     Particles<Dim, Real>& p, Regions<Dim>& regions, geometry::Shape shape) {
+  const int layers = static_cast<int>(e.integer("layers", 3, 1, 10));
+  const bool inside = e.boolean("inside", false);
+  e.finish();
+  const double depth = layers * spacing;
+  const double estimate = 1.5 * shape.area() * depth / std::pow(spacing, Dim) + 8;
+  budget_shape<Dim>(budget, shape, spacing, inside ? depth : 0, estimate, ob, std::to_string(k),
+                    "this obstacle");
+  for (const auto& x : geometry::sample(shape, spacing, inside, depth)) {
+    Vec<Dim, Real> v;
+    for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
+    add_particle(p, v, 0, ParticleKind::Boundary);
+  }
+  regions.shape_keys.push_back(e.path());
+  regions.all_shapes.push_back(shape);
+  regions.shape_margins.push_back(inside ? depth : 0);
+  (inside ? regions.container_shapes : regions.solid_shapes).push_back(std::move(shape));
+}
+
+template <int Dim, class Real>
+void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, ParticleBudget& budget,
+                    Particles<Dim, Real>& p, Regions<Dim>& regions) {
   if (!br.has("obstacles")) return;
   auto ob = br.child("obstacles");
   for (std::size_t k = 0; k < ob.array_size(); ++k) {
     auto e = ob.element(k);
+    if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+    if (auto shape = read_shape<Dim>(e, spacing, files)) {
+      add_shape_walls(ob, e, k, spacing, budget, p, regions, std::move(*shape));
+      continue;
+    }
     const auto b = read_box<Dim>(e);
     e.finish();
     const auto n = cells_of<Dim>(b, spacing);
@@ -581,8 +729,8 @@ void read_obstacles(JsonReader& br, double spacing, ParticleBudget& budget, Part
 
 // Makes the wall and obstacle particles (after the fluid blocks were counted, before they are made).
 template <int Dim, class Real>
-Regions<Dim> read_boundary(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg,
-                           ParticleBudget& budget, Particles<Dim, Real>& p) {
+Regions<Dim> read_boundary(JsonReader& r, double spacing, const MeshFiles& files,
+                           SolverConfig<Dim, Real>& cfg, ParticleBudget& budget, Particles<Dim, Real>& p) {
   Regions<Dim> regions;
   if (!r.has("boundary")) return regions;
   auto br = r.child("boundary");
@@ -591,7 +739,7 @@ Regions<Dim> read_boundary(JsonReader& r, double spacing, SolverConfig<Dim, Real
   read_box_boundary(br, spacing, cfg, regions);
   read_planes(br, cfg);
   read_walls(br, spacing, cfg, budget, p, regions);
-  read_obstacles(br, spacing, budget, p, regions);
+  read_obstacles(br, spacing, files, budget, p, regions);
   br.finish();
   return regions;
 }
@@ -602,6 +750,17 @@ void read_domain(JsonReader& r, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regi
   auto dr = r.child("domain");
   const auto b = read_box<Dim>(dr);
   dr.finish();
+  // Every shaped obstacle (with the walls a container puts outside it) must fit the domain.
+  for (std::size_t k = 0; k < regions.all_shapes.size(); ++k) {
+    const auto& s = regions.all_shapes[k];
+    const double m = regions.shape_margins[k];
+    for (std::size_t a = 0; a < Dim; ++a)
+      if (s.lo()[a] - m < b.lo[a] || s.hi()[a] + m > b.hi[a])
+        r.fail("domain", "does not hold the shape of " + regions.shape_keys[k] +
+                             " (with its walls): on axis " + std::to_string(a) + " it spans " +
+                             std::to_string(s.lo()[a] - m) + " to " + std::to_string(s.hi()[a] + m) +
+                             ", the domain " + std::to_string(b.lo[a]) + " to " + std::to_string(b.hi[a]));
+  }
   cfg.domain_set = true;
   cfg.domain_lo = to_vec<Dim, Real>(b.lo);
   cfg.domain_hi = to_vec<Dim, Real>(b.hi);
@@ -632,11 +791,52 @@ template <int Dim>
 struct FluidBlocks {
   std::vector<Aabb<Dim>> blocks;
   std::vector<std::int32_t> phase;  // of each block
+  // Shaped fluid volumes: their bounds (for the overlap checks), and the particles each made.
+  std::vector<Aabb<Dim>> shape_bounds;
+  std::vector<std::pair<std::size_t, std::size_t>> shape_ranges;
+  std::vector<std::int32_t> shape_phase;
 };
 
+// Whether a fluid particle at x keeps half a spacing outside every shaped obstacle and inside some shaped
+// container (the box walls' rule: fluid half a spacing from the wall's face).
+template <int Dim>
+bool clear_of_walls(const geometry::P3& x, const Regions<Dim>& regions, double spacing) {
+  const double gap = 0.5 * spacing * (1 - 1e-9);
+  for (const auto& s : regions.solid_shapes) {
+    const auto side = s.classify(x, gap);
+    if (side.sign <= 0 || side.distance < gap) return false;
+  }
+  if (regions.container_shapes.empty()) return true;
+  for (const auto& s : regions.container_shapes) {
+    const auto side = s.classify(x, gap);
+    if (side.sign < 0 && !(side.distance < gap)) return true;
+  }
+  return false;
+}
+
+// Adds the fluid particles at `xs` that are clear of the shaped walls; returns how many.
 template <int Dim, class Real>
-FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const PhaseTable& phases,
-                             const Regions<Dim>& regions, Particles<Dim, Real>& p) {
+std::size_t add_fluid(Particles<Dim, Real>& p, const std::vector<geometry::P3>& xs,
+                      const Regions<Dim>& regions, double spacing, std::int32_t phase,
+                      const Vec<Dim, Real>& vel) {
+  std::vector<std::uint8_t> keep(xs.size(), 1);
+  if (!regions.solid_shapes.empty() || !regions.container_shapes.empty())
+    parallel_for(xs.size(),
+                 [&](std::size_t i) { keep[i] = clear_of_walls(xs[i], regions, spacing) ? 1 : 0; });
+  std::size_t added = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    if (!keep[i]) continue;
+    Vec<Dim, Real> v;
+    for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(xs[i][static_cast<std::size_t>(a)]);
+    add_particle(p, v, phase, ParticleKind::Fluid, Real(0), vel);
+    ++added;
+  }
+  return added;
+}
+
+template <int Dim, class Real>
+FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const MeshFiles& files, const PhaseTable& phases,
+                             const Regions<Dim>& regions, ParticleBudget& budget, Particles<Dim, Real>& p) {
   if (!r.has("fluids")) r.fail("fluids", "missing (a list of fluid blocks is required)");
   auto fr = r.child("fluids");
   const std::size_t nf = fr.array_size();
@@ -646,6 +846,38 @@ FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const PhaseTable& ph
   for (std::size_t k = 0; k < nf; ++k) {
     auto e = fr.element(k);
     if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+    if (auto shape = read_shape<Dim>(e, spacing, files)) {
+      const std::int32_t phase = phases.read_reference(e);
+      const auto vel = to_vec<Dim, Real>(e.vector("velocity", Dim, filled<Dim>(0)));
+      e.finish();
+      Aabb<Dim> b{filled<Dim>(0), filled<Dim>(0)};
+      for (std::size_t a = 0; a < Dim; ++a) {
+        b.lo[a] = shape->lo()[a];
+        b.hi[a] = shape->hi()[a];
+      }
+      for (std::size_t o = 0; o < out.blocks.size(); ++o)
+        if (overlap<Dim>(b, out.blocks[o], tol))
+          e.fail_here("overlaps fluid block " + std::to_string(o) +
+                      " (the bounds of a shaped fluid volume must not)");
+      for (std::size_t o = 0; o < out.shape_bounds.size(); ++o)
+        if (overlap<Dim>(b, out.shape_bounds[o], tol))
+          e.fail_here("overlaps a shaped fluid volume before it (their bounds must not)");
+      for (std::size_t o = 0; o < regions.solids.size(); ++o)
+        if (overlap<Dim>(b, regions.solids[o], tol))
+          e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
+      if (regions.container && !inside<Dim>(b, *regions.container, tol))
+        e.fail_here("lies (partly) outside the boundary box");
+      budget_shape<Dim>(budget, *shape, spacing, 0, 1.1 * shape->volume() / std::pow(spacing, Dim) + 8, fr,
+                        std::to_string(k), "this fluid volume");
+      const std::size_t first = p.size();
+      if (add_fluid(p, geometry::sample(*shape, spacing, false, HUGE_VAL), regions, spacing, phase, vel) == 0)
+        e.fail_here("holds no particle: no lattice site of spacing " + std::to_string(spacing) +
+                    " lies inside it, half a spacing inside the containers and outside the obstacles");
+      out.shape_bounds.push_back(b);
+      out.shape_ranges.emplace_back(first, p.size());
+      out.shape_phase.push_back(phase);
+      continue;
+    }
     const auto b = read_box<Dim>(e);
     const std::int32_t phase = phases.read_reference(e);
     const auto vel = to_vec<Dim, Real>(e.vector("velocity", Dim, filled<Dim>(0)));
@@ -659,6 +891,9 @@ FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const PhaseTable& ph
       if (overlap<Dim>(b, out.blocks[o], tol))
         e.fail_here("overlaps fluid block " + std::to_string(o) +
                     " (particles would sit on top of each other)");
+    for (std::size_t o = 0; o < out.shape_bounds.size(); ++o)
+      if (overlap<Dim>(b, out.shape_bounds[o], tol))
+        e.fail_here("overlaps a shaped fluid volume before it (their bounds must not)");
     for (std::size_t o = 0; o < regions.solids.size(); ++o)
       if (overlap<Dim>(b, regions.solids[o], tol))
         e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
@@ -666,11 +901,76 @@ FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const PhaseTable& ph
       e.fail_here("lies (partly) outside the boundary box");
     out.blocks.push_back(b);
     out.phase.push_back(phase);
-    const std::size_t first = p.size();
-    add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
-    for (std::size_t i = first; i < p.size(); ++i) p.v[i] = vel;
+    if (regions.solid_shapes.empty() && regions.container_shapes.empty()) {
+      const std::size_t first = p.size();
+      add_block(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), phase);
+      for (std::size_t i = first; i < p.size(); ++i) p.v[i] = vel;
+      continue;
+    }
+    // With shaped walls: the block's lattice (add_block's), less what is not clear of them.
+    std::vector<geometry::P3> xs;
+    xs.reserve(static_cast<std::size_t>(n[0] * n[1] * n[2]));
+    for (long kk = 0; kk < n[2]; ++kk)
+      for (long jj = 0; jj < n[1]; ++jj)
+        for (long ii = 0; ii < n[0]; ++ii) {
+          const long idx[3] = {ii, jj, kk};
+          geometry::P3 x{0, 0, 0};
+          for (std::size_t a = 0; a < Dim; ++a) {
+            const auto lo = static_cast<Real>(b.lo[a]);
+            x[a] = double(lo + (Real(idx[a]) + Real(0.5)) * static_cast<Real>(spacing));
+          }
+          xs.push_back(x);
+        }
+    if (add_fluid(p, xs, regions, spacing, phase, vel) == 0)
+      e.fail_here("holds no particle half a spacing inside the containers and outside the obstacles");
   }
   return out;
+}
+
+// The hydrostatic pressure of each shaped fluid volume's own weight, rho0 |g| (n + 1/2) spacing for a
+// particle with n particles of its volume above it in its lattice column (gravity along an axis).
+template <int Dim, class Real>
+std::vector<double> shaped_fluid_pressure(const JsonReader& r, double spacing,
+                                          const SolverConfig<Dim, Real>& cfg, const FluidBlocks<Dim>& fluids,
+                                          const Particles<Dim, Real>& p) {
+  std::vector<double> extra(p.size(), 0);
+  if (fluids.shape_ranges.empty()) return extra;
+  int axis = -1, nonzero = 0;
+  for (int a = 0; a < Dim; ++a)
+    if (cfg.gravity[a] != 0) {
+      axis = a;
+      ++nonzero;
+    }
+  if (nonzero == 0) return extra;
+  if (nonzero > 1)
+    r.fail("initial_pressure", "\"hydrostatic\" with a shaped fluid volume needs gravity along one axis");
+  const double g = std::abs(double(cfg.gravity[axis]));
+  const double up = cfg.gravity[axis] < 0 ? 1 : -1;
+  for (std::size_t f = 0; f < fluids.shape_ranges.size(); ++f) {
+    const auto [first, end] = fluids.shape_ranges[f];
+    const double rho0 = double(cfg.phases[static_cast<std::size_t>(fluids.shape_phase[f])].rest_density);
+    // Sorted by column, then by height against gravity.
+    std::vector<std::pair<std::array<long, 3>, std::size_t>> keys;
+    keys.reserve(end - first);
+    for (std::size_t i = first; i < end; ++i) {
+      std::array<long, 3> k{0, 0, 0};
+      int slot = 0;
+      for (int a = 0; a < Dim; ++a)
+        if (a != axis) k[static_cast<std::size_t>(slot++)] = std::lround(double(p.x[i][a]) / spacing - 0.5);
+      k[2] = std::lround(up * double(p.x[i][axis]) / spacing);
+      keys.emplace_back(k, i);
+    }
+    std::sort(keys.begin(), keys.end());
+    for (std::size_t c = 0; c < keys.size();) {
+      std::size_t e = c;
+      while (e < keys.size() && keys[e].first[0] == keys[c].first[0] && keys[e].first[1] == keys[c].first[1])
+        ++e;
+      for (std::size_t q = c; q < e; ++q)
+        extra[keys[q].second] = rho0 * g * (double(e - q - 1) + 0.5) * spacing;
+      c = e;
+    }
+  }
+  return extra;
 }
 
 template <int Dim, class Real>
@@ -678,7 +978,8 @@ void read_initial_pressure(JsonReader& r, double spacing, const SolverConfig<Dim
                            const PhaseTable& phases, const FluidBlocks<Dim>& fluids,
                            Particles<Dim, Real>& p) {
   if (r.choice("initial_pressure", "zero", {"zero", "hydrostatic"}) == "hydrostatic")
-    start_hydrostatic(p, cfg, spacing, phases.mass_given, fluids.blocks, fluids.phase);
+    start_hydrostatic(p, cfg, spacing, phases.mass_given, fluids.blocks, fluids.phase,
+                      shaped_fluid_pressure(r, spacing, cfg, fluids, p));
 }
 
 // --- output (/output) ---------------------------------------------------------------------------
@@ -790,9 +1091,10 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   ParticleBudget budget(Dim, spacing, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing,
                         limits.memory_bytes);
   budget.take(count_fluid_particles<Dim>(j, spacing), r, "fluids", "the fluid blocks");
-  Regions<Dim> regions = read_boundary(r, spacing, cfg, budget, s.particles);
+  const MeshFiles files = mesh_files_of(source);
+  Regions<Dim> regions = read_boundary(r, spacing, files, cfg, budget, s.particles);
   read_domain(r, cfg, regions);
-  const FluidBlocks<Dim> fluids = read_fluids(r, spacing, phases, regions, s.particles);
+  const FluidBlocks<Dim> fluids = read_fluids(r, spacing, files, phases, regions, budget, s.particles);
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
 
   read_output<Dim>(r, s.output);

@@ -24,13 +24,13 @@ nlohmann::json with(const char* base, const std::string& pointer, const nlohmann
 }
 
 // Loads and returns the error message ("" when the scene is valid).
-std::string load_error(const nlohmann::json& j) {
+std::string load_error(const nlohmann::json& j, const std::string& source = "scene.json") {
   try {
-    const auto h = read_scene_header(j, "scene.json");
+    const auto h = read_scene_header(j, source);
     if (h.dim == 2)
-      load_scene<2, double>(j, "scene.json");
+      load_scene<2, double>(j, source);
     else
-      load_scene<3, double>(j, "scene.json");
+      load_scene<3, double>(j, source);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -42,7 +42,7 @@ TEST(Scene, EveryBuiltinSceneLoads) {
   for (const auto& s : builtin_scenes()) {
     std::string src;
     const auto j = read_scene_json(std::string(s.name), src);
-    EXPECT_EQ(load_error(j), "") << s.name;
+    EXPECT_EQ(load_error(j, src), "") << s.name;  // src: meshes/FILE is a built-in scene's mesh
     const auto h = read_scene_header(j, src);
     EXPECT_EQ(h.name, s.name) << "a built-in scene's name must match its file name";
     EXPECT_FALSE(h.description.empty()) << s.name;

@@ -45,7 +45,12 @@ nlohmann::json coarsened(nlohmann::json j) {
   double volume = 0;
   for (const auto& b : j["fluids"]) {
     double v = 1;
-    for (int a = 0; a < dim; ++a) v *= b["max"][a].get<double>() - b["min"][a].get<double>();
+    if (b.contains("sphere")) {  // shaped fluid volumes (geometry/shape.hpp): the sphere's volume
+      const double r = b["sphere"]["radius"].get<double>();
+      v = dim == 2 ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
+    } else {
+      for (int a = 0; a < dim; ++a) v *= b["max"][a].get<double>() - b["min"][a].get<double>();
+    }
     volume += v;
   }
   const double s = j["spacing"].get<double>();
@@ -149,7 +154,8 @@ void check_inside(const Simulation<Dim, Real>& sim, const nlohmann::json& j, con
 
 template <int Dim, class Real>
 void run_scene(const nlohmann::json& j, const std::string& name) {
-  auto scene = load_scene<Dim, Real>(j, name);
+  // The source read_scene_json gives a built-in scene (its meshes/FILE are the compiled-in meshes).
+  auto scene = load_scene<Dim, Real>(j, "built-in scene " + name);
   ScopedThreads one(1);
   Simulation<Dim, Real> sim(scene.solver, scene.particles);
   // Tolerance: 10% of the gravitational energy scale of the fluid (m g times the fluid's height), or,

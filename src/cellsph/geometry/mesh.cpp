@@ -1,0 +1,314 @@
+#include "cellsph/geometry/mesh.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <unordered_map>
+
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/Importer.hpp>
+
+#include "cellsph/core/error.hpp"
+
+namespace cellsph::geometry {
+
+namespace {
+
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string point_text(const P3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", p[0], p[1], p[2]);
+  return buf;
+}
+
+[[noreturn]] void fail(const std::string& label, const std::string& what) {
+  throw InputError(label + ": " + what);
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// Assimp decides between binary and ASCII STL as we do here, but says only "Failed to determine STL
+// storage representation"; a truncated binary file deserves its sizes in the message. Binary: an 80-byte
+// header, a 32-bit little-endian triangle count C, then exactly 50 bytes per triangle.
+void check_stl(std::string_view b, const std::string& label) {
+  if (b.size() >= 84) {
+    std::uint32_t count = 0;
+    for (int k = 3; k >= 0; --k)
+      count = (count << 8) | static_cast<unsigned char>(b[80 + static_cast<std::size_t>(k)]);
+    if (84 + 50 * std::uint64_t{count} == b.size()) return;  // binary
+  }
+  std::size_t i = 0;
+  while (i < b.size() && std::isspace(static_cast<unsigned char>(b[i]))) ++i;
+  if (b.substr(i, 5) == "solid") {
+    // ASCII: text only (Assimp's own test looks at the first bytes; we look at all of them).
+    for (std::size_t k = 0; k < b.size(); ++k) {
+      const auto c = static_cast<unsigned char>(b[k]);
+      if (c == 0 || c >= 0x80)
+        fail(label, "starts like an ASCII STL file (\"solid\") but byte " + std::to_string(k) +
+                        " is not text, and its size (" + std::to_string(b.size()) +
+                        " bytes) is not that of a binary STL file");
+    }
+    return;
+  }
+  if (b.size() < 84)
+    fail(label, "is neither an ASCII STL file (it does not start with \"solid\") nor a binary one (" +
+                    std::to_string(b.size()) + " bytes, fewer than the 84 of a binary STL header)");
+  std::uint32_t count = 0;
+  for (int k = 3; k >= 0; --k)
+    count = (count << 8) | static_cast<unsigned char>(b[80 + static_cast<std::size_t>(k)]);
+  fail(label, "binary STL header announces " + std::to_string(count) + " triangles (" +
+                  std::to_string(84 + 50 * std::uint64_t{count}) + " bytes) but the file has " +
+                  std::to_string(b.size()) + " bytes: truncated, or not an STL file");
+}
+
+// Assimp's PLY reader reserves memory for the counts the header announces before reading the data: a
+// 40-byte header that announces 10^12 vertices would ask for terabytes. Every element takes at least one
+// byte (ASCII: a digit and a separator; binary: a property), so the counts must not exceed the bytes
+// after the header.
+void check_ply(std::string_view b, const std::string& label) {
+  if (b.substr(0, 3) != "ply") fail(label, "is not a PLY file (it does not start with \"ply\")");
+  const auto end = b.find("end_header");
+  if (end == std::string_view::npos) fail(label, "PLY header has no end_header line");
+  const std::size_t data = b.size() - end;
+  std::size_t pos = 0;
+  double total = 0;
+  while (pos < end) {
+    std::size_t nl = b.find('\n', pos);
+    if (nl == std::string_view::npos || nl > end) nl = end;
+    const std::string_view line = b.substr(pos, nl - pos);
+    pos = nl + 1;
+    if (line.substr(0, 8) != "element ") continue;
+    const auto sp = line.rfind(' ');
+    double count = 0;
+    bool digits = sp + 1 < line.size();
+    for (std::size_t k = sp + 1; k < line.size(); ++k) {
+      const char c = line[k];
+      if (c == '\r') break;
+      if (c < '0' || c > '9') {
+        digits = false;
+        break;
+      }
+      count = count * 10 + (c - '0');
+    }
+    if (!digits)
+      fail(label, "PLY header line \"" + std::string(line.substr(0, 60)) + "\" has no element count");
+    total += count;
+  }
+  if (total > double(data))
+    fail(label, "PLY header announces " + num(total) + " elements but only " + std::to_string(data) +
+                    " bytes follow it: truncated, or not a PLY file");
+}
+
+}  // namespace
+
+TriangleMesh read_mesh_file(const std::filesystem::path& file, const std::string& label) {
+  const std::string ext = lower(file.extension().string());
+  if (ext != ".stl" && ext != ".obj" && ext != ".ply")
+    fail(label, "unknown mesh format \"" + file.extension().string() + "\" (expected .stl, .obj or .ply)");
+  std::error_code ec;
+  const auto status = std::filesystem::status(file, ec);
+  if (ec || !std::filesystem::exists(status)) fail(label, "no such file");
+  if (std::filesystem::is_directory(status)) fail(label, "is a folder, not a mesh file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(label, std::string("cannot be opened: ") + std::strerror(errno));
+  std::string bytes;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    bytes.append(buf, static_cast<std::size_t>(in.gcount()));
+    if (bytes.size() > kMaxFileBytes) fail(label, "is larger than 1 GiB");
+  }
+  if (in.bad()) fail(label, "read error");
+  return parse_mesh(bytes, ext.substr(1), label);
+}
+
+TriangleMesh parse_mesh(std::string_view bytes, std::string_view extension, const std::string& label) {
+  const std::string ext = lower(extension);
+  if (ext != "stl" && ext != "obj" && ext != "ply")
+    fail(label, "unknown mesh format \"" + std::string(extension) + "\" (expected stl, obj or ply)");
+  if (bytes.empty()) fail(label, "is empty");
+  if (ext == "stl") check_stl(bytes, label);
+  if (ext == "ply") check_ply(bytes, label);
+
+  Assimp::Importer importer;
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  // From memory with the extension as the hint: only that format's reader runs, and an OBJ file's
+  // "mtllib" cannot make Assimp open other files (there are none in its memory file system).
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(),
+                                        aiProcess_Triangulate | aiProcess_ValidateDataStructure, ext.c_str());
+  } catch (const std::exception& e) {
+    fail(label, std::string("cannot be read as ") + ext + ": " + e.what());
+  }
+  if (!scene) {
+    std::string why = importer.GetErrorString();
+    while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+    fail(label, "cannot be read as " + ext + " (Assimp: " + (why.empty() ? "no reason given" : why) + ")");
+  }
+
+  TriangleMesh m;
+  struct Key {
+    float x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::uint32_t b[3];
+      std::memcpy(b, &k, sizeof b);
+      return (std::size_t{b[0]} * 0x9E3779B1u) ^ (std::size_t{b[1]} * 0x85EBCA77u) ^
+             (std::size_t{b[2]} * 0xC2B2AE3Du) ^ (std::size_t{b[2]} << 32);
+    }
+  };
+  std::unordered_map<Key, std::uint32_t, KeyHash> index;
+  std::size_t lines_or_points = 0;
+  for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
+    const aiMesh* am = scene->mMeshes[mi];
+    if (!am) continue;
+    std::vector<std::uint32_t> local(am->mNumVertices, std::numeric_limits<std::uint32_t>::max());
+    auto vertex = [&](unsigned v) -> std::uint32_t {
+      if (v >= am->mNumVertices)
+        fail(label,
+             "a face refers to vertex " + std::to_string(v) + " of " + std::to_string(am->mNumVertices));
+      if (local[v] != std::numeric_limits<std::uint32_t>::max()) return local[v];
+      const aiVector3D& a = am->mVertices[v];
+      if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(a.z))
+        fail(label, "vertex " + std::to_string(v + 1) + " has a coordinate that is not a finite number");
+      const Key k{a.x + 0.0f, a.y + 0.0f, a.z + 0.0f};  // + 0: -0 and 0 are one vertex
+      auto [it, added] = index.try_emplace(k, static_cast<std::uint32_t>(m.vertices.size()));
+      if (added) m.vertices.push_back({double(a.x), double(a.y), double(a.z)});
+      return local[v] = it->second;
+    };
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3 || !face.mIndices) {
+        ++lines_or_points;
+        continue;
+      }
+      const std::array<std::uint32_t, 3> t{vertex(face.mIndices[0]), vertex(face.mIndices[1]),
+                                           vertex(face.mIndices[2])};
+      m.triangles.push_back(t);
+    }
+  }
+  if (m.triangles.empty())
+    fail(label, lines_or_points ? "has only points or lines, no triangles (a closed surface is needed)"
+                                : "has no triangles");
+  if (lines_or_points)
+    fail(label, "has " + std::to_string(lines_or_points) +
+                    " points or lines besides its triangles (a closed surface of triangles is needed)");
+  return m;
+}
+
+void transform(TriangleMesh& m, const MeshTransform& t) {
+  double len = std::sqrt(t.axis[0] * t.axis[0] + t.axis[1] * t.axis[1] + t.axis[2] * t.axis[2]);
+  const P3 u{t.axis[0] / len, t.axis[1] / len, t.axis[2] / len};
+  const double a = t.angle_deg * M_PI / 180, c = std::cos(a), s = std::sin(a);
+  for (auto& p : m.vertices) {
+    const P3 q{p[0] * t.scale, p[1] * t.scale, p[2] * t.scale};
+    // Rodrigues: q cos + (u x q) sin + u (u . q)(1 - cos)
+    const double d = u[0] * q[0] + u[1] * q[1] + u[2] * q[2];
+    const P3 x{u[1] * q[2] - u[2] * q[1], u[2] * q[0] - u[0] * q[2], u[0] * q[1] - u[1] * q[0]};
+    for (int k = 0; k < 3; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      p[i] = q[i] * c + x[i] * s + u[i] * d * (1 - c) + t.translate[i];
+    }
+  }
+}
+
+double volume(const TriangleMesh& m) {
+  double v = 0;
+  for (const auto& t : m.triangles) {
+    const P3 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
+    v += a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+         a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return v / 6;
+}
+
+void bounds(const TriangleMesh& m, P3& lo, P3& hi) {
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  for (const auto& p : m.vertices)
+    for (std::size_t a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+    }
+}
+
+void check_closed(TriangleMesh& m, const std::string& label) {
+  // Triangles with a repeated vertex enclose nothing and share no edge: drop them.
+  std::erase_if(m.triangles, [](const auto& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; });
+  if (m.triangles.empty()) fail(label, "has only degenerate triangles (each with a repeated vertex)");
+  struct Edge {
+    std::uint32_t lo, hi, tri;
+    bool forward;  // traversed lo -> hi
+  };
+  std::vector<Edge> edges;
+  edges.reserve(3 * m.triangles.size());
+  for (std::size_t t = 0; t < m.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = m.triangles[t][static_cast<std::size_t>(k)],
+                          b = m.triangles[t][static_cast<std::size_t>((k + 1) % 3)];
+      edges.push_back({std::min(a, b), std::max(a, b), static_cast<std::uint32_t>(t), a < b});
+    }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.tri < y.tri;
+  });
+  // The bad edge group whose first triangle comes first in the file.
+  std::size_t bad = edges.size(), bad_end = 0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+    const bool ok = j - i == 2 && edges[i].forward != edges[i + 1].forward;
+    if (!ok && (bad == edges.size() || edges[i].tri < edges[bad].tri)) {
+      bad = i;
+      bad_end = j;
+    }
+    i = j;
+  }
+  if (bad < edges.size()) {
+    const Edge& e = edges[bad];
+    const std::string which =
+        "the edge from " + point_text(m.vertices[e.lo]) + " to " + point_text(m.vertices[e.hi]);
+    const std::size_t n = bad_end - bad;
+    if (n == 1)
+      fail(label, "is not a closed surface: " + which + " belongs to triangle " + std::to_string(e.tri + 1) +
+                      " only (a closed surface has every edge in exactly two triangles)");
+    if (n > 2)
+      fail(label, "is not a closed surface: " + which + " belongs to " + std::to_string(n) + " triangles (" +
+                      std::to_string(e.tri + 1) + ", " + std::to_string(edges[bad + 1].tri + 1) +
+                      ", ...); a closed surface has every edge in exactly two");
+    fail(label, "is not consistently oriented: triangles " + std::to_string(e.tri + 1) + " and " +
+                    std::to_string(edges[bad + 1].tri + 1) + " both run along " + which +
+                    " in the same direction (one of them faces the wrong way)");
+  }
+  double v = volume(m);
+  P3 lo, hi;
+  bounds(m, lo, hi);
+  double diag = 0;
+  for (std::size_t a = 0; a < 3; ++a) diag = std::max(diag, hi[a] - lo[a]);
+  if (!(std::abs(v) > 1e-9 * diag * diag * diag))
+    fail(label,
+         "encloses zero volume (" + num(v) + ", bounds " + point_text(lo) + " to " + point_text(hi) + ")");
+  if (v < 0)
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+}
+
+}  // namespace cellsph::geometry
