@@ -56,9 +56,18 @@ TriangleMesh icosphere(int level) {
   return m;
 }
 
+// A file removed when the program ends.
+struct TempFile {
+  std::filesystem::path path;
+  ~TempFile() {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+};
+
 // The icosphere as a binary STL file in the temp folder (written once).
 const std::filesystem::path& stl_file() {
-  static const std::filesystem::path file = [] {
+  static const TempFile file{[] {
     const auto m = icosphere(6);
     const auto f =
         std::filesystem::temp_directory_path() / ("cellsph-bench-" + std::to_string(getpid()) + ".stl");
@@ -78,8 +87,8 @@ const std::filesystem::path& stl_file() {
       out.write(reinterpret_cast<const char*>(&attr), 2);
     }
     return f;
-  }();
-  return file;
+  }()};
+  return file.path;
 }
 
 void BM_MeshReadAndCheck(benchmark::State& state) {
