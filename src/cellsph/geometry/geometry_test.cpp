@@ -202,6 +202,26 @@ TEST(Shape, MeshInsideAndDistanceMatchTheAnalyticBox) {
   }
 }
 
+// Lattice rows that run exactly through the mesh's edges and vertices: the unit cube moved so that its
+// corners sit on lattice site coordinates (0.05 and 1.05 at spacing 0.1). The rows with y = z run along
+// the diagonals of the x faces (an edge of two triangles), others through corners and along face edges. A
+// ray through an edge must cross once: the 9^3 sites strictly inside are inside, nothing else is.
+TEST(Shape, RowsThroughEdgesAndVerticesCrossOnce) {
+  const double s = 0.1;
+  TriangleMesh m = read_mesh_file(kMeshes / "cube.obj", "cube.obj");
+  check_closed(m, "cube.obj");
+  MeshTransform t;
+  t.translate = {0.05, 0.05, 0.05};
+  transform(m, t);
+  const auto inside = sample(Shape::mesh(m, s), s, false, HUGE_VAL);
+  EXPECT_EQ(inside.size(), 9u * 9u * 9u);
+  for (const auto& p : inside)
+    for (double c : p) {
+      EXPECT_GT(c, 0.1) << p[0] << " " << p[1] << " " << p[2];
+      EXPECT_LT(c, 1.0) << p[0] << " " << p[1] << " " << p[2];
+    }
+}
+
 // Wall particles: layers inside an obstacle, outside a container, at their requested depth (the
 // distance to the analytic sphere within half a spacing of the band (0, layers spacing]), and the band
 // without holes.

@@ -135,7 +135,11 @@ class MeshDistance {
       });
     }
     volume_ = geometry::volume(m_);
+    on_surface_ = 1e-12 * std::max(ext, 1e-300);
   }
+
+  // Points closer than this to the surface are on it (rounding in the distance is far below it).
+  [[nodiscard]] double on_surface() const { return on_surface_; }
 
   // The x of every crossing of the line (y, z) along x with the surface, sorted. A line through a
   // shared edge or vertex crosses once: the edge functions are evaluated the same way for both triangles
@@ -157,7 +161,8 @@ class MeshDistance {
       if (!covers(f0, t[1], t[2], s) || !covers(f1, t[2], t[0], s) || !covers(f2, t[0], t[1], s)) continue;
       const double sum = f0 + f1 + f2;
       if (!(sum > 0)) continue;
-      xs.push_back((f0 * a[0] + f1 * b[0] + f2 * cc[0]) / sum);
+      // From a's x, so that a face at one x gives exactly that x (sites on it are on the surface).
+      xs.push_back(a[0] + (f1 * (b[0] - a[0]) + f2 * (cc[0] - a[0])) / sum);
     }
     std::sort(xs.begin(), xs.end());
   }
@@ -237,7 +242,7 @@ class MeshDistance {
 
   TriangleMesh m_;
   Bins yz_, xyz_;
-  double volume_ = 0;
+  double volume_ = 0, on_surface_ = 0;
 };
 
 Shape Shape::sphere(const Sphere& s, int dim) {
@@ -333,8 +338,9 @@ Side Shape::classify(const P3& p, double band) const {
       mesh_->crossings(p[1], p[2], xs);
       const auto above = std::upper_bound(xs.begin(), xs.end(), p[0]);
       if (above != xs.begin() && *(above - 1) == p[0]) return {0, 0};
-      Side s{(xs.end() - above) % 2 ? -1 : 1, mesh_->distance(p, band)};
-      if (s.distance == 0) s.sign = 0;
+      Side s{(xs.end() - above) % 2 ? -1 : 1, mesh_->distance(p, std::max(band, mesh_->on_surface()))};
+      if (s.distance <= mesh_->on_surface()) return {0, 0};
+      if (s.distance > band) s.distance = std::numeric_limits<double>::infinity();
       return s;
     }
   }
@@ -378,8 +384,10 @@ std::vector<P3> sample(const Shape& s, double spacing, bool outside, double dept
           if (above != xs.begin() && *(above - 1) == p[0]) continue;  // on the surface
           side.sign = (xs.end() - above) % 2 ? -1 : 1;
           if (side.sign != want) continue;
-          side.distance = band > 0 ? s.mesh_->distance(p, band) : 0;
-          if (side.distance == 0 && band > 0) continue;
+          // A site on the surface (a face through the row's sites) is on neither side.
+          const double eps = s.mesh_->on_surface();
+          side.distance = s.mesh_->distance(p, std::max(band, eps));
+          if (side.distance <= eps) continue;
         } else {
           side = s.classify(p, band);
         }
