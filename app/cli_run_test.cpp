@@ -293,8 +293,11 @@ TEST(CliRun, ScenesListsEveryBuiltinScene) {
   TempDir dir;
   const auto r = run_cli(dir, "scenes");
   EXPECT_EQ(r.code, 0);
+  // The JSON files of scenes/ (its folders hold meshes and examples that are not built in).
   for (const auto& e : fs::directory_iterator(fs::path(CELLSPH_SOURCE_DIR) / "scenes"))
-    EXPECT_NE(r.out.find(e.path().stem().string()), std::string::npos) << e.path();
+    if (e.path().extension() == ".json") {
+      EXPECT_NE(r.out.find(e.path().stem().string()), std::string::npos) << e.path();
+    }
 }
 
 }  // namespace
