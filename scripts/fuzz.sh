@@ -29,6 +29,7 @@ mkdir -p "$WORK"
 export TMPDIR=$WORK  # the frames_index harness's scratch folder
 export OMP_NUM_THREADS=1
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1
+export LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp  # Assimp's own leaks (fuzz/lsan.supp says which)
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 RUNS=()
 [ -n "${FUZZ_RUNS:-}" ] && RUNS=(-runs="$FUZZ_RUNS")

@@ -25,6 +25,7 @@ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCELLSPH_SA
   -DCELLSPH_BUILD_BENCHMARKS=OFF -DCELLSPH_BUILD_PYTHON=OFF >/dev/null
 cmake --build build/asan -j "$JOBS"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp \
   ctest --test-dir build/asan -j "$JOBS" --output-on-failure
 
 echo "== fuzzing: every reader for ${FUZZ_SECONDS:-45} s under libFuzzer + ASan + UBSan =="

@@ -95,6 +95,38 @@ TEST(MeshFile, BadFilesNameTheFileAndTheProblem) {
   }
 }
 
+// Polygons are split by us (Assimp's triangulation aborts on some inputs: fuzz/regressions/mesh/).
+TEST(MeshFile, QuadsAreSplitIntoTriangles) {
+  const std::string quads =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+      "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  TriangleMesh m = parse_mesh(quads, "obj", "quads.obj");
+  EXPECT_EQ(m.triangles.size(), 12u);
+  ASSERT_NO_THROW(check_closed(m, "quads.obj"));
+  EXPECT_DOUBLE_EQ(volume(m), 1.0);
+}
+
+// PLY headers are checked before Assimp sees them: it loops without end on one whose end_header is in a
+// comment, and reserves what the counts announce.
+TEST(MeshFile, MalformedPlyHeadersAreRefusedBeforeAssimp) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"ply\nformat ascii 1.0\ncomment x end_header\n1 0 0\n", "PLY header line 4: unexpected \"1 0 0\""},
+      {"ply\nformat ascii 1.0\nelement vertex 1000000000000\nelement face 1\nend_header\n1 2 3\n",
+       "announces 1e+12 elements but only 6 bytes follow it"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nend_header\n0 0 0\n1 0 0\n0 1 0\n", "no \"element face\""},
+      {"ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header line"},
+      {"plx\n", "is not a PLY file"},
+  };
+  for (const auto& [text, mention] : cases) {
+    try {
+      parse_mesh(text, "ply", "h.ply");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(MeshFile, TruncationsOfABinaryStlAreRefusedNeverCrash) {
   std::ifstream in(kMeshes / "cube-binary.stl", std::ios::binary);
   std::stringstream ss;

@@ -79,39 +79,52 @@ void check_stl(std::string_view b, const std::string& label) {
                   std::to_string(b.size()) + " bytes: truncated, or not an STL file");
 }
 
-// Assimp's PLY reader reserves memory for the counts the header announces before reading the data: a
-// 40-byte header that announces 10^12 vertices would ask for terabytes. Every element takes at least one
-// byte (ASCII: a digit and a separator; binary: a property), so the counts must not exceed the bytes
-// after the header.
+// Assimp's PLY reader reserves memory for the counts the header announces before reading the data (a
+// 40-byte header announcing 10^12 vertices would ask for terabytes), and loops without end on some headers
+// it cannot parse (one whose "end_header" is inside a comment: fuzz/regressions/mesh/ply-end-header-in-
+// comment). So the header must be well formed before Assimp sees it: "ply", a "format" line, then only
+// comment, obj_info, element and property lines up to a line "end_header"; an "element vertex" and an
+// "element face"; and the counts no more than the bytes after the header (every element takes at least one).
 void check_ply(std::string_view b, const std::string& label) {
-  if (b.substr(0, 3) != "ply") fail(label, "is not a PLY file (it does not start with \"ply\")");
-  const auto end = b.find("end_header");
-  if (end == std::string_view::npos) fail(label, "PLY header has no end_header line");
-  const std::size_t data = b.size() - end;
-  std::size_t pos = 0;
+  std::size_t pos = 0, line_no = 0, data = 0;
   double total = 0;
-  while (pos < end) {
+  bool vertex = false, face = false, ended = false;
+  while (pos < b.size() && !ended) {
     std::size_t nl = b.find('\n', pos);
-    if (nl == std::string_view::npos || nl > end) nl = end;
-    const std::string_view line = b.substr(pos, nl - pos);
+    if (nl == std::string_view::npos) nl = b.size();
+    std::string_view line = b.substr(pos, nl - pos);
     pos = nl + 1;
-    if (line.substr(0, 8) != "element ") continue;
-    const auto sp = line.rfind(' ');
-    double count = 0;
-    bool digits = sp + 1 < line.size();
-    for (std::size_t k = sp + 1; k < line.size(); ++k) {
-      const char c = line[k];
-      if (c == '\r') break;
-      if (c < '0' || c > '9') {
-        digits = false;
-        break;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    const std::string where = "PLY header line " + std::to_string(line_no);
+    auto word = [&](std::string_view w) {
+      return line.substr(0, w.size()) == w && (line.size() == w.size() || line[w.size()] == ' ');
+    };
+    if (line_no == 1) {
+      if (line != "ply") fail(label, "is not a PLY file (its first line is not \"ply\")");
+    } else if (line_no == 2) {
+      if (!word("format")) fail(label, where + ": expected \"format ...\"");
+    } else if (line == "end_header") {
+      ended = true;
+      data = b.size() - std::min(b.size(), pos);
+    } else if (word("element")) {
+      const auto sp = line.rfind(' ');
+      double count = 0;
+      bool digits = sp != std::string_view::npos && sp + 1 < line.size() && sp > 7;
+      for (std::size_t k = sp + 1; digits && k < line.size(); ++k) {
+        if (line[k] < '0' || line[k] > '9') digits = false;
+        count = count * 10 + (line[k] - '0');
       }
-      count = count * 10 + (c - '0');
+      if (!digits) fail(label, where + ": an element needs a name and a count");
+      vertex = vertex || word("element vertex");
+      face = face || word("element face");
+      total += count;
+    } else if (!word("property") && !word("comment") && !word("obj_info")) {
+      fail(label, where + ": unexpected \"" + std::string(line.substr(0, 40)) + "\" in the header");
     }
-    if (!digits)
-      fail(label, "PLY header line \"" + std::string(line.substr(0, 60)) + "\" has no element count");
-    total += count;
   }
+  if (!ended) fail(label, "PLY header has no end_header line");
+  if (!vertex || !face) fail(label, "PLY header announces no \"element vertex\" or no \"element face\"");
   if (total > double(data))
     fail(label, "PLY header announces " + num(total) + " elements but only " + std::to_string(data) +
                     " bytes follow it: truncated, or not a PLY file");
@@ -153,8 +166,10 @@ TriangleMesh parse_mesh(std::string_view bytes, std::string_view extension, cons
   // "mtllib" cannot make Assimp open other files (there are none in its memory file system).
   const aiScene* scene = nullptr;
   try {
-    scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(),
-                                        aiProcess_Triangulate | aiProcess_ValidateDataStructure, ext.c_str());
+    // No aiProcess_Triangulate: Debian's Assimp 5.2.5 aborts in it (an ai_assert) on some polygon
+    // lists (fuzz/regressions/mesh/assimp-triangulate-abort); polygons are split below, as fans.
+    scene =
+        importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure, ext.c_str());
   } catch (const std::exception& e) {
     fail(label, std::string("cannot be read as ") + ext + ": " + e.what());
   }
@@ -196,15 +211,17 @@ TriangleMesh parse_mesh(std::string_view bytes, std::string_view extension, cons
       if (added) m.vertices.push_back({double(a.x), double(a.y), double(a.z)});
       return local[v] = it->second;
     };
+    if (am->mNumFaces > 0 && !am->mFaces) fail(label, "a mesh has faces but no face list");
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3 || !face.mIndices) {
+      if (face.mNumIndices < 3 || !face.mIndices) {
         ++lines_or_points;
         continue;
       }
-      const std::array<std::uint32_t, 3> t{vertex(face.mIndices[0]), vertex(face.mIndices[1]),
-                                           vertex(face.mIndices[2])};
-      m.triangles.push_back(t);
+      // A polygon of n vertices: the fan of n - 2 triangles from its first vertex.
+      const std::uint32_t first = vertex(face.mIndices[0]);
+      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+        m.triangles.push_back({first, vertex(face.mIndices[k]), vertex(face.mIndices[k + 1])});
     }
   }
   if (m.triangles.empty())
