@@ -42,8 +42,8 @@ void transform(TriangleMesh& m, const MeshTransform& t);
 // Checks that the mesh is a closed, consistently oriented surface that encloses a volume: every edge
 // belongs to exactly two triangles that traverse it in opposite directions. The message names the first
 // bad edge (in the order of the file's triangles) by its two vertices' coordinates and the triangle
-// (1-based, after polygons are split into fans of triangles from their first vertex). A mesh whose triangles face inwards (negative
-// volume) is turned outwards; one that encloses zero volume is refused.
+// (1-based, after polygons are split into fans of triangles from their first vertex). A mesh whose triangles
+// face inwards (negative volume) is turned outwards; one that encloses zero volume is refused.
 void check_closed(TriangleMesh& m, const std::string& label);
 
 // Signed volume enclosed (divergence theorem): positive when the triangles face outwards.
