@@ -179,6 +179,8 @@ class Simulation {
   // WallModel::Dynamic: sum_c m_c W_wc over the wall particles c within h of wall w (w itself included),
   // the constant part of w's summation density (walls never move); 0 for fluid slots.
   std::vector<Real> wall_self_rho_;
+  // WCSPH continuity density: d rho / dt of the step (models/continuity_density.hpp); read within the step.
+  std::vector<Real> drho_;
   // Indices of the fluid particles, ascending. Kinds never change, and reordering permutes particles
   // only among the slots of their own kind, so this list is fixed for a simulation.
   std::vector<std::uint32_t> fluid_;
