@@ -151,29 +151,33 @@ CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, R
 // V_i V_j and F_ij / (2 V_j): f_ij = -f_ji exactly (momentum); it acts along v_ij, not x_ij, so it does not
 // conserve angular momentum exactly (Morris's operator).
 template <int Dim, class Real>
-CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const Vec<Dim, Real>& vij, const Vec<Dim, Real>& grad_w,
-                                                        const Vec<Dim, Real>& xij, Real r, Real vol_i, Real vol_j,
-                                                        Real mui, Real muj, Real eta2) {
+CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const Vec<Dim, Real>& vij,
+                                                        const Vec<Dim, Real>& grad_w,
+                                                        const Vec<Dim, Real>& xij, Real r, Real vol_i,
+                                                        Real vol_j, Real mui, Real muj, Real eta2) {
   return vij * (vol_i * vol_j * (mui + muj) * dot(xij, grad_w) / (r * r + eta2));
 }
 
 // hs: the smoothing length (support / 2) of the 0.01 hs^2 regulariser.
 template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w, Real hs) {
-  return morris_viscosity_force(in.vij, w.gradW(in.xij), in.xij, in.r, in.mi / in.rhoi, in.mj / in.rhoj, in.mui,
-                                in.muj, Real(0.01) * hs * hs);
+CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w,
+                                                        Real hs) {
+  return morris_viscosity_force(in.vij, w.gradW(in.xij), in.xij, in.r, in.mi / in.rhoi, in.mj / in.rhoj,
+                                in.mui, in.muj, Real(0.01) * hs * hs);
 }
 
 // Monaghan's (1992) artificial viscosity, for approaching pairs (v_ij . x_ij < 0) only:
-//   Pi_ij = -alpha c0 mu_ij / rho_ij,   mu_ij = h (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2),  rho_ij = (rho_i + rho_j)/2,
-//   f_i = -sum_j m_i m_j Pi_ij grad W_ij,
+//   Pi_ij = -alpha c0 mu_ij / rho_ij,   mu_ij = h (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2),  rho_ij = (rho_i +
+//   rho_j)/2, f_i = -sum_j m_i m_j Pi_ij grad W_ij,
 // with h the smoothing length (support / 2) and c0 the speed of sound at rest. Its shear viscosity is about
 // nu = alpha h c0 / (2 (d + 2)) (Monaghan 2005): a numerical damping, not the fluid's viscosity.
 // alpha_c0_h = alpha c0 h (one product per pass), eps2 = 0.01 h^2.
 template <int Dim, class Real>
-CELLSPH_HD inline Vec<Dim, Real> artificial_viscosity_force(const Vec<Dim, Real>& vij, const Vec<Dim, Real>& grad_w,
-                                                            const Vec<Dim, Real>& xij, Real r, Real mi, Real mj,
-                                                            Real rhoi, Real rhoj, Real alpha_c0_h, Real eps2) {
+CELLSPH_HD inline Vec<Dim, Real> artificial_viscosity_force(const Vec<Dim, Real>& vij,
+                                                            const Vec<Dim, Real>& grad_w,
+                                                            const Vec<Dim, Real>& xij, Real r, Real mi,
+                                                            Real mj, Real rhoi, Real rhoj, Real alpha_c0_h,
+                                                            Real eps2) {
   const Real vx = dot(vij, xij);
   if (!(vx < 0)) return Vec<Dim, Real>{};
   const Real pi_ij = -alpha_c0_h * vx / (r * r + eps2) / ((rhoi + rhoj) / 2);

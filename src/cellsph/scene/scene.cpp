@@ -416,7 +416,8 @@ void read_density_diffusion(JsonReader& sr, SolverConfig<Dim, Real>& cfg) {
       static_cast<Real>(dr.number("delta", double(cfg.density_diffusion.delta), 0, 1));
   if (cfg.density_diffusion.kind != DensityDiffusion::None &&
       cfg.density_evolution != DensityEvolution::Continuity)
-    dr.fail("kind", "\"" + kind + "\" diffuses an integrated density: needs /solver/density = \"continuity\"");
+    dr.fail("kind",
+            "\"" + kind + "\" diffuses an integrated density: needs /solver/density = \"continuity\"");
   dr.finish();
 }
 

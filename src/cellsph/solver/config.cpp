@@ -78,7 +78,8 @@ void SolverConfig<Dim, Real>::validate() const {
     if (density_evolution != DensityEvolution::Continuity)
       bad("density_diffusion.kind", density_diffusion_name(density_diffusion.kind),
           "diffuses an integrated density: needs density = continuity");
-    if (!(std::isfinite(density_diffusion.delta) && density_diffusion.delta >= 0 && density_diffusion.delta <= 1))
+    if (!(std::isfinite(density_diffusion.delta) && density_diffusion.delta >= 0 &&
+          density_diffusion.delta <= 1))
       bad("density_diffusion.delta", density_diffusion.delta, "must be in [0, 1]");
   }
   if (!(std::isfinite(artificial_viscosity.alpha) && artificial_viscosity.alpha >= 0 &&

@@ -116,9 +116,9 @@ struct SolverConfig {
   Model model = Model::PaperMultiphase;
 
   // Kernels. Density uses `density_kernel` (the paper: poly6), pressure the gradient of `pressure_kernel`
-  // (the paper: spiky); the WCSPH model also uses that gradient in the laminar (Morris) and artificial (Monaghan) viscosities. The
-  // paper's viscosity (eq. 8b) always uses the viscosity kernel's Laplacian, whose positivity it relies
-  // on, and the colour field always uses poly6 (eq. 8c).
+  // (the paper: spiky); the WCSPH model also uses that gradient in the laminar (Morris) and artificial
+  // (Monaghan) viscosities. The paper's viscosity (eq. 8b) always uses the viscosity kernel's Laplacian,
+  // whose positivity it relies on, and the colour field always uses poly6 (eq. 8c).
   KernelKind density_kernel = KernelKind::Poly6;
   KernelKind pressure_kernel = KernelKind::Spiky;
   Real support = Real(0.05);  // h [m]: kernel support and neighbour radius (paper eq. 14)

@@ -115,7 +115,8 @@ TEST(ArtificialViscosity, ApproachingPairsOnlyAndAntisymmetric) {
   const V2 xij{{0.012, 0.005}};
   const double r = norm(xij);
   const V2 approach{{-1, 0.2}}, recede{{1, 0.2}};
-  const auto f = artificial_viscosity_force(approach, w.gradW(xij), xij, r, 0.4, 0.5, 1000., 1010., 1.0, 4e-6);
+  const auto f =
+      artificial_viscosity_force(approach, w.gradW(xij), xij, r, 0.4, 0.5, 1000., 1010., 1.0, 4e-6);
   const auto g = artificial_viscosity_force(V2(-approach), w.gradW(V2(-xij)), V2(-xij), r, 0.5, 0.4, 1010.,
                                             1000., 1.0, 4e-6);
   EXPECT_GT(norm(f), 0);
@@ -238,7 +239,8 @@ TEST(DensityDiffusion, ConservesTheVolumeWeightedDensity) {
       net += p.m[i] / p.rho[i] * d;
       gross += std::abs(p.m[i] / p.rho[i] * d);
     }
-    std::cout << density_diffusion_name(kind) << ": sum V d rho/dt " << net << " of sum |.| " << gross << "\n";
+    std::cout << density_diffusion_name(kind) << ": sum V d rho/dt " << net << " of sum |.| " << gross
+              << "\n";
     EXPECT_GT(gross, 0);
     EXPECT_LT(std::abs(net), 1e-9 * gross);
   }
@@ -247,7 +249,8 @@ TEST(DensityDiffusion, ConservesTheVolumeWeightedDensity) {
 // Keys of the scene reader: values and combinations that make no sense are InputErrors naming them.
 std::string scene_error(const std::string& solver) {
   const auto j = nlohmann::json::parse(R"({"dimension": 2, "spacing": 0.05,
-      "fluids": [{"min": [0, 0], "max": [0.5, 0.5]}], "solver": )" + solver + "}");
+      "fluids": [{"min": [0, 0], "max": [0.5, 0.5]}], "solver": )" +
+                                       solver + "}");
   try {
     (void)load_scene<2, double>(j, "t.json");
   } catch (const InputError& e) {
@@ -353,17 +356,23 @@ TankFigures resting_tank(const std::string& density, const std::string& diffusio
   return t;
 }
 
+// Fourtakas's diffusion against none and against summation density, Akinci walls (hydrostatic-tank's):
+// less noise than either and a mean within 3% of rho0 g depth. (docs/physics.md has the full-size tank.)
 TEST(DensityDiffusion, RestingTankPressureAgainstHydrostatic) {
-  for (const std::string walls : {"dynamic", "adami", "akinci"}) {
+  const auto none = resting_tank("continuity", "none", "akinci");
+  const auto fourtakas = resting_tank("continuity", "fourtakas", "akinci");
+  const auto summation = resting_tank("mass", "", "akinci");
+  EXPECT_LT(fourtakas.noise, none.noise);
+  EXPECT_LT(fourtakas.noise, summation.noise);
+  EXPECT_LT(fourtakas.bias, 0.03);
+}
+
+// The other wall models with Fourtakas's diffusion: figures only (printed), a bound on the bias.
+TEST(DensityDiffusion, RestingTankWithAdamiAndDynamicWalls) {
+  for (const std::string walls : {"adami", "dynamic"}) {
     SCOPED_TRACE(walls);
-    const auto none = resting_tank("continuity", "none", walls);
-    const auto molteni = resting_tank("continuity", "molteni", walls);
     const auto fourtakas = resting_tank("continuity", "fourtakas", walls);
-    const auto summation = resting_tank("mass", "", walls);
-    (void)none;
-    (void)molteni;
-    (void)fourtakas;
-    (void)summation;
+    EXPECT_LT(fourtakas.bias, 0.05);
   }
 }
 

@@ -624,6 +624,11 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
       throw InputError(source + ": particle " + std::to_string(i) + " has time-step level " +
                        std::to_string(particles.level[i]) + " / tick " + std::to_string(particles.tick[i]) +
                        ", outside 0.." + std::to_string(cfg_.time.max_level) + " / 0..2^62");
+    // The continuity density is state: a fluid density of 0 or less would divide by zero in the next step.
+    if (particles.kind[i] == kFluid && cfg_.density_evolution == DensityEvolution::Continuity &&
+        !(particles.rho[i] > 0))
+      throw InputError(source + ": fluid particle " + std::to_string(i) + " has density " +
+                       std::to_string(particles.rho[i]) + " (the continuity density needs one > 0)");
     if (particles.kind[i] == kFluid) {
       lo_tick = std::min(lo_tick, particles.tick[i]);
       hi_tick = std::max(hi_tick, particles.tick[i]);

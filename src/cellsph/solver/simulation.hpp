@@ -69,9 +69,10 @@ class Simulation {
   // inputs (id may be left empty or all 0: the input order; otherwise it must be a permutation of
   // 0..n-1; v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid
   // particle: the phase's mass). support, colour and viscosity are set from the config and the phase table,
-  // density to the rest density; boundary particles with m == 0 get their Akinci weight psi_b in m (a
-  // positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick,
-  // m = rho0 spacing^Dim makes the wall look exactly like fluid).
+  // density to the rest density (with the continuity density, a fluid particle's positive, finite input
+  // density is kept as its initial density); boundary particles with m == 0 get their Akinci weight psi_b in
+  // m (a positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick, m =
+  // rho0 spacing^Dim makes the wall look exactly like fluid).
   Simulation(Config config, Particles<Dim, Real> particles);
 
   // One time step of the configured model (with per-particle steps: advances the particles whose own

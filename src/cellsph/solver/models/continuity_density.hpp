@@ -48,8 +48,8 @@ struct ContinuityRatePass {
   Kernel w;  // the density kernel
   EquationOfState<Real> eos;
   Vec<Dim, Real> gravity;
-  Real delta_h_c0;  // 0: no diffusion
-  Real eta2;        // 0.01 h^2
+  Real delta_h_c0;   // 0: no diffusion
+  Real eta2;         // 0.01 h^2
   bool hydrostatic;  // Fourtakas: subtract the hydrostatic density difference
 
   CELLSPH_HD void operator()(std::size_t i) const {
@@ -83,7 +83,8 @@ struct ContinuityIntegratePass {
 
 // Pressures of `set` (the fluid) from their carried densities.
 template <int Dim, class Real>
-void continuity_state(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& set) {
+void continuity_state(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
+                      const IndexSet& set) {
   run_pass(set, ContinuityStatePass<Dim, Real>{pv, cfg.eos});
 }
 
@@ -104,12 +105,12 @@ Real reference_sound_speed(const SolverConfig<Dim, Real>& cfg) {
 
 // d rho / dt of `set` (the fluid), after the kick (models/wcsph.hpp), before the drift.
 template <int Dim, class Real>
-void continuity_rate(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& set) {
+void continuity_rate(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
+                     const IndexSet& set) {
   const Real h = smoothing_length(cfg);
   const auto kind = cfg.density_diffusion.kind;
-  const Real dhc = kind == DensityDiffusion::None
-                       ? Real(0)
-                       : cfg.density_diffusion.delta * h * reference_sound_speed(cfg);
+  const Real dhc =
+      kind == DensityDiffusion::None ? Real(0) : cfg.density_diffusion.delta * h * reference_sound_speed(cfg);
   with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
     using K = std::remove_cvref_t<decltype(w)>;
     run_pass(set, ContinuityRatePass<Dim, Real, K>{pv, w, cfg.eos, cfg.gravity, dhc, Real(0.01) * h * h,

@@ -6,7 +6,8 @@
 //    (the laminar viscosity of Morris et al. 1997 with each phase's mu, Monaghan's artificial viscosity
 //    when alpha > 0, gravity, Mueller 2003 surface tension) in f, the symmetric pressure force in
 //    f_pressure: WcsphForcesPass. Walls: the laminar term only with slip = no-slip (against the wall's
-//    velocity: at rest, or Adami's extrapolated one), the artificial one only with artificial_viscosity.walls;
+//    velocity: at rest, or Adami's extrapolated one), the artificial one only with
+//    artificial_viscosity.walls;
 //  * operator splitting with symplectic Euler: WcsphSymplecticEulerPass.
 // The pair formulas are in physics/interactions.hpp; wall particles enter as the boundary model says
 // (boundary/).
@@ -33,8 +34,8 @@ struct WcsphForcesPass {
   Real lap_self;  // wc.laplacian(0)
   Real eta2;      // the r^2 regulariser 0.01 h_s^2 (h_s = support / 2, the smoothing length)
   Real tension_threshold;
-  Real alpha_c0_h;  // artificial viscosity alpha c0 h_s; 0: none
-  bool av_walls;    // artificial viscosity between fluid and wall particles too
+  Real alpha_c0_h;   // artificial viscosity alpha c0 h_s; 0: none
+  bool av_walls;     // artificial viscosity between fluid and wall particles too
   bool any_tension;  // some phase has sigma > 0
   bool wall_states;  // Adami or dynamic walls: wall particles carry p, rho, vol, prho2 and wall_v
   bool no_slip;
@@ -145,9 +146,10 @@ void wcsph_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Re
   const Real alpha_c0_h = cfg.artificial_viscosity.alpha * reference_sound_speed(cfg) * h;
   with_kernel<Dim, Real>(cfg.pressure_kernel, cfg.support, [&](const auto wg) {
     using K = std::remove_cvref_t<decltype(wg)>;
-    run_pass(set, WcsphForcesPass<Dim, Real, K>{pv, wg, wc, cfg.gravity, wc.laplacian(0), Real(0.01) * h * h,
-                                                cfg.tension_threshold, alpha_c0_h, cfg.artificial_viscosity.walls,
-                                                any_tension, wall_states, cfg.no_slip, cfg.eos.clamp_negative});
+    run_pass(set,
+             WcsphForcesPass<Dim, Real, K>{pv, wg, wc, cfg.gravity, wc.laplacian(0), Real(0.01) * h * h,
+                                           cfg.tension_threshold, alpha_c0_h, cfg.artificial_viscosity.walls,
+                                           any_tension, wall_states, cfg.no_slip, cfg.eos.clamp_negative});
   });
 }
 
