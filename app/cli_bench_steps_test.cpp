@@ -40,6 +40,7 @@ TEST(BenchCli, StepsComparesPerParticleWithTheGlobalStep) {
   const auto r = run_cli(
       dir,
       "bench steps --scene dam-break-2d --set '/solver/model=\"paper\"' --set '/boundary/model=\"akinci\"' "
+      "--set /solver/artificial_viscosity/alpha=0 "
       "--set /spacing=0.1 "
       "--set /solver/support=0.2 --set /phases/0/viscosity=0.5 --set /solver/eos/stiffness=9000 "
       "--dt-max 0.01 --end 0.2 --sample 0.1 --threads 2");

@@ -479,6 +479,8 @@ void run_bench_sph(const SphArgs& a) {
         j["spacing"] = spacing;
         j["solver"]["support"] = 2 * spacing;
         j["solver"]["model"] = model;
+        // The paper model has no artificial viscosity (eq. 8b with the phase's mu only).
+        if (model == "paper") j["solver"].erase("artificial_viscosity");
         j["precision"] = prec;
         j["neighbors"]["method"] = "cell-index";
         if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;

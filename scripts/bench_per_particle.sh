@@ -31,7 +31,7 @@ echo "== paper-dam-break-1, dt_max = 0.01 s (the default; the c limit falls betw
 for c in 62.61 20 8 4 3 2; do
   echo "== 2D dam break, paper model, c = $c m/s"
   "$bin" bench steps --scene dam-break-2d --set '/solver/model="paper"' --set '/boundary/model="akinci"' \
-    --set /spacing=0.04 --set /solver/support=0.08 --set /phases/0/viscosity=0.5 \
+    --set /solver/artificial_viscosity/alpha=0 --set /spacing=0.04 --set /solver/support=0.08 --set /phases/0/viscosity=0.5 \
     --set '/boundary/planes=[{"normal":[0,1],"point":[0,0]},{"normal":[1,0],"point":[0,0]},{"normal":[-1,0],"point":[4,0]}]' \
     --set "/solver/eos/stiffness=$(python3 -c "print($c*$c*1000)")" --dt-max "$(limit "$c" 0.08 0.0005)" \
     --end 1.0 --sample 0.2 --threads "$threads" || echo "(unstable: see the message above)"

@@ -70,10 +70,16 @@ bool same_fields(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
 }
 
 template <int Dim, class Real>
-void resume_is_bit_identical(Model model) {
+void resume_is_bit_identical(Model model, bool continuity = false) {
   ScopedThreads one(1);
   test::TempDir dir("sim_ckpt");
-  const auto cfg = config<Dim, Real>(model);
+  auto cfg = config<Dim, Real>(model);
+  if (continuity) {
+    // The density is then state, integrated step by step: the checkpoint must carry it.
+    cfg.density_evolution = DensityEvolution::Continuity;
+    cfg.density_diffusion.kind = DensityDiffusion::Fourtakas;
+    cfg.artificial_viscosity.alpha = Real(0.05);
+  }
   Simulation<Dim, Real> full(cfg, block<Dim, Real>(5));
   for (int s = 0; s < 20; ++s) full.step();
   const std::string extra("caller\0bytes", 12);  // any bytes, a NUL included
@@ -106,6 +112,12 @@ TEST(SimulationCheckpoint, ResumeIsBitIdenticalPaper3DFloat) {
 }
 TEST(SimulationCheckpoint, ResumeIsBitIdenticalWcsph2DFloat) {
   resume_is_bit_identical<2, float>(Model::Wcsph);
+}
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalWcsphContinuityFourtakas2DDouble) {
+  resume_is_bit_identical<2, double>(Model::Wcsph, true);
+}
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalWcsphContinuityFourtakas3DFloat) {
+  resume_is_bit_identical<3, float>(Model::Wcsph, true);
 }
 
 std::string load_error(const std::filesystem::path& path, Simulation<2, double>& sim) {

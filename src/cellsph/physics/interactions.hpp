@@ -9,6 +9,7 @@
 
 #include "cellsph/core/hd.hpp"
 #include "cellsph/core/vec.hpp"
+#include "cellsph/physics/eos.hpp"
 
 namespace cellsph {
 
@@ -31,6 +32,45 @@ struct PairInput {
 template <class Real, class Kernel>
 CELLSPH_HD inline Real density_term(const Kernel& w, Real mj, Real r2) {
   return mj * w.W2(r2);
+}
+
+// The continuity equation (WCSPH, density = continuity): d rho_i / dt = sum_j m_j (v_i - v_j) . grad W_ij,
+// the exact time derivative of the summation sum_j m_j W_ij over the same neighbours (walls included, with
+// their weights and velocities), so on a lattice at rest both agree for all time.
+template <int Dim, class Real>
+CELLSPH_HD inline Real continuity_term(const Vec<Dim, Real>& grad_w, Real mj, const Vec<Dim, Real>& vij) {
+  return mj * dot(vij, grad_w);
+}
+
+// The pair weight of the SPH Laplacian of Brookshaw (1985) and Morris et al. (1997):
+//   lap A_i = sum_j (A_i - A_j) F_ij,   F_ij = 2 V_j (x_ij . grad W_ij) / (|x_ij|^2 + eta2),
+// eta2 (0.01 h^2) keeping it finite as r -> 0. Exact for quadratic fields on a full lattice in the limit;
+// x_ij . grad W_ij <= 0, so F_ij <= 0 and the operator diffuses. The density diffusion and the laminar
+// viscosity below are both this Laplacian.
+template <int Dim, class Real>
+CELLSPH_HD inline Real brookshaw_weight(const Vec<Dim, Real>& grad_w, const Vec<Dim, Real>& xij, Real r,
+                                        Real vol_j, Real eta2) {
+  return Real(2) * vol_j * dot(xij, grad_w) / (r * r + eta2);
+}
+
+// Density diffusion (delta-SPH) of Molteni & Colagrossi 2009: d rho_i / dt += delta h c0 lap(rho)_i, the pair
+// term delta h c0 (rho_i - rho_j - drho_h) F_ij with F_ij = brookshaw_weight(...). Molteni's drho_h = 0;
+// Fourtakas et al. 2019 subtract the hydrostatic density difference (hydrostatic_density_difference), so that
+// a fluid at rest under gravity, whose density increases with depth, is not diffused towards uniform
+// density (the diffusion of the total density is what makes a still tank sink at walls and free surfaces).
+// Symmetric F_ij V_i = F_ji V_j: sum_i V_i (this term) = 0, the volume-weighted density is conserved.
+template <class Real>
+CELLSPH_HD inline Real density_diffusion_term(Real delta_h_c0, Real rhoi, Real rhoj, Real drho_h, Real fij) {
+  return delta_h_c0 * (rhoi - rhoj - drho_h) * fij;
+}
+
+// Fourtakas et al. 2019: rho^H_i - rho^H_j, the difference of the hydrostatic densities at x_i and x_j, from
+// the hydrostatic pressure difference rho0 g . x_ij through the equation of state (for Tait this is their
+// rho0 ((1 + rho0 g z_ij / C_B)^(1/gamma) - 1)).
+template <int Dim, class Real>
+CELLSPH_HD inline Real hydrostatic_density_difference(const EquationOfState<Real>& eos, Real rho0,
+                                                      const Vec<Dim, Real>& g, const Vec<Dim, Real>& xij) {
+  return eos.density(rho0 * dot(g, xij), rho0) - rho0;
 }
 
 // ---- The paper's averaged forces (eq. 8a, 8b) --------------------------------------------------
@@ -99,33 +139,49 @@ CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const Vec<Dim, Real>& 
   return grad_w * (-mi * mj * (prho2_i + prho2_j));
 }
 
-// Monaghan's viscosity operator (SPH derivative combined with a finite difference, Koschier et al. 2020):
-//   lap v_i = 2(d+2) sum_j V_j (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2) grad W_ij,
-// the 0.01 h^2 (eps2) keeping the quotient finite as r -> 0. Written as a force with V_i V_j and the mean
-// dynamic viscosity, so that f_ij = -f_ji exactly. Against a wall with i's viscosity the caller passes
-// mu_j = mu_i.
-template <int Dim, class Real>
-CELLSPH_HD inline Real monaghan_quotient(const Vec<Dim, Real>& vij, const Vec<Dim, Real>& xij, Real r,
-                                         Real eps2) {
-  return dot(vij, xij) / (r * r + eps2);
-}
-template <int Dim, class Real>
-CELLSPH_HD inline Vec<Dim, Real> monaghan_viscosity_force(const Vec<Dim, Real>& grad_w, Real vol_i,
-                                                          Real vol_j, Real mui, Real muj, Real q) {
-  return grad_w * (Real(2 * (Dim + 2)) * (mui + muj) / 2 * vol_i * vol_j * q);
-}
-
 template <int Dim, class Real, class Kernel>
 CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
   return symmetric_pressure_force(w.gradW(in.xij), in.mi, in.mj, in.pi / (in.rhoi * in.rhoi),
                                   in.pj / (in.rhoj * in.rhoj));
 }
 
+// Laminar viscosity of Morris, Fox & Zhu 1997 (WCSPH's physical viscosity, phases[].viscosity in Pa s):
+//   f_i = sum_j m_i m_j (mu_i + mu_j) / (rho_i rho_j) (x_ij . grad W_ij) / (|x_ij|^2 + eta2) v_ij,
+// i.e. m_i / rho_i div(mu grad v) with the Laplacian above (for equal mu, m_i mu / rho_i lap v). Written with
+// V_i V_j and F_ij / (2 V_j): f_ij = -f_ji exactly (momentum); it acts along v_ij, not x_ij, so it does not
+// conserve angular momentum exactly (Morris's operator).
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const Vec<Dim, Real>& vij,
+                                                        const Vec<Dim, Real>& grad_w,
+                                                        const Vec<Dim, Real>& xij, Real r, Real vol_i,
+                                                        Real vol_j, Real mui, Real muj, Real eta2) {
+  return vij * (vol_i * vol_j * (mui + muj) * dot(xij, grad_w) / (r * r + eta2));
+}
+
+// hs: the smoothing length (support / 2) of the 0.01 hs^2 regulariser.
 template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Vec<Dim, Real> monaghan_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w,
-                                                          Real h) {
-  const Real q = monaghan_quotient(in.vij, in.xij, in.r, Real(0.01) * h * h);
-  return monaghan_viscosity_force(w.gradW(in.xij), in.mi / in.rhoi, in.mj / in.rhoj, in.mui, in.muj, q);
+CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w,
+                                                        Real hs) {
+  return morris_viscosity_force(in.vij, w.gradW(in.xij), in.xij, in.r, in.mi / in.rhoi, in.mj / in.rhoj,
+                                in.mui, in.muj, Real(0.01) * hs * hs);
+}
+
+// Monaghan's (1992) artificial viscosity, for approaching pairs (v_ij . x_ij < 0) only:
+//   Pi_ij = -alpha c0 mu_ij / rho_ij,   mu_ij = h (v_ij . x_ij) / (|x_ij|^2 + 0.01 h^2),  rho_ij = (rho_i +
+//   rho_j)/2, f_i = -sum_j m_i m_j Pi_ij grad W_ij,
+// with h the smoothing length (support / 2) and c0 the speed of sound at rest. Its shear viscosity is about
+// nu = alpha h c0 / (2 (d + 2)) (Monaghan 2005): a numerical damping, not the fluid's viscosity.
+// alpha_c0_h = alpha c0 h (one product per pass), eps2 = 0.01 h^2.
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> artificial_viscosity_force(const Vec<Dim, Real>& vij,
+                                                            const Vec<Dim, Real>& grad_w,
+                                                            const Vec<Dim, Real>& xij, Real r, Real mi,
+                                                            Real mj, Real rhoi, Real rhoj, Real alpha_c0_h,
+                                                            Real eps2) {
+  const Real vx = dot(vij, xij);
+  if (!(vx < 0)) return Vec<Dim, Real>{};
+  const Real pi_ij = -alpha_c0_h * vx / (r * r + eps2) / ((rhoi + rhoj) / 2);
+  return grad_w * (-mi * mj * pi_ij);
 }
 
 // ---- Boundary particles (Akinci et al. 2012) ----------------------------------------------------

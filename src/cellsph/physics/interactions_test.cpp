@@ -102,11 +102,11 @@ TEST(Interactions, PairForcesAreAntisymmetric) {
     expect_opposite(averaged_pressure_force(in, spiky), averaged_pressure_force(back, spiky));
     expect_opposite(averaged_viscosity_force(in, visc), averaged_viscosity_force(back, visc));
     expect_opposite(symmetric_pressure_force(in, cubic), symmetric_pressure_force(back, cubic));
-    expect_opposite(monaghan_viscosity_force(in, cubic, h), monaghan_viscosity_force(back, cubic, h));
-    // Viscosity removes relative kinetic energy: the force on i opposes v_i - v_j (eq. 8b), or at least
-    // the approaching/receding component along x_ij (Monaghan).
+    expect_opposite(morris_viscosity_force(in, cubic, h / 2), morris_viscosity_force(back, cubic, h / 2));
+    // Viscosity removes relative kinetic energy: the force on i opposes v_i - v_j (eq. 8b; Morris's acts
+    // along v_ij).
     EXPECT_LE(dot(averaged_viscosity_force(in, visc), in.vij), 0);
-    EXPECT_LE(dot(monaghan_viscosity_force(in, cubic, h), in.vij), 1e-15);
+    EXPECT_LE(dot(morris_viscosity_force(in, cubic, h / 2), in.vij), 1e-15);
   }
 }
 

@@ -1,7 +1,7 @@
 // The built-in dam-break-2d scene (Koshizuka & Oka 1996: a 1 m x 2 m water column in a 4 m tank),
 // coarsened to 0.1 m, against the published surge front. Its set-up is the scene file's: WCSPH, cubic
-// kernels, c = 10 sqrt(2 g H), mu from Monaghan's alpha = 0.02 (rho0 alpha h c / (2 (d + 2)), so 6.26 Pa s
-// at the scene's 0.02 m and 31.3 Pa s here), no-slip walls, a hydrostatic start; both wall models.
+// kernels, c = 10 sqrt(2 g H), water's viscosity 0.001 Pa s and Monaghan's artificial viscosity alpha = 0.01
+// (which scales with h by itself), no-slip walls, a hydrostatic start; both wall models.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,17 +22,17 @@ namespace {
 
 class DamBreakFront : public ::testing::TestWithParam<std::string> {};
 
-// The surge front (the largest x of a fluid particle plus half a spacing) must be within 10% of every
-// published point up to T = t sqrt(2g/a) = 3. Measured worst errors at this spacing: docs/physics.md
-// ("The 2D dam break at full resolution"); finer runs lead the experiment between T = 0.8 and 1.6, so
-// this is a check of the set-up at CI resolution, not a convergence claim.
-TEST_P(DamBreakFront, KoshizukaOkaWithinTenPercent) {
+// The surge front (the largest x of a fluid particle plus half a spacing) must be within 20% of every
+// published point up to T = t sqrt(2g/a) = 3: solvers of every kind lead this hand-released experiment by
+// roughly 10-20% around T = 1-1.5 (shared/validation/README.md), and with water's viscosity instead of the
+// former artificial viscosity written as 6.26 Pa s this one does too (15% at this spacing, docs/physics.md,
+// "The 2D dam break at full resolution"). A check of the set-up at CI resolution, not a validation.
+TEST_P(DamBreakFront, KoshizukaOkaWithinTwentyPercent) {
   const double s = 0.1, g = 9.81, a = 1.0;
   std::string source;
   auto j = read_scene_json("dam-break-2d", source);
   j["spacing"] = s;
   j["solver"]["support"] = 2 * s;
-  j["phases"][0]["viscosity"] = 6.26 * s / 0.02;
   j["boundary"]["model"] = GetParam();
   j["neighbors"]["method"] = "all-pairs";
   const auto scene = load_scene<2, double>(j, source);
@@ -60,7 +60,7 @@ TEST_P(DamBreakFront, KoshizukaOkaWithinTenPercent) {
       if (sim.particles().kind[i] == 0) front = std::max(front, sim.particles().x[i][0]);
     front += s / 2;
     worst = std::max(worst, std::abs(front - x) / x);
-    EXPECT_NEAR(front, x, 0.1 * x) << "t = " << sim.time() << " s";
+    EXPECT_NEAR(front, x, 0.2 * x) << "t = " << sim.time() << " s";
   }
   std::cout << "[dam break] walls " << GetParam() << ": worst front error " << 100 * worst << "% over "
             << ref.size() << " points\n";

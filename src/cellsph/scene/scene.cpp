@@ -240,6 +240,8 @@ void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& c
     const double rho = double(cfg.eos.density(static_cast<Real>(pressure), rho0));
     p.m[i] = mass_given[ph] ? static_cast<Real>(double(cfg.phases[ph].mass) * rho / double(rho0))
                             : static_cast<Real>(rho * volume);
+    // The continuity density starts from it (summation density recomputes it from the masses).
+    if (p.rho.size() == p.size()) p.rho[i] = static_cast<Real>(rho);
   }
 }
 
@@ -413,6 +415,37 @@ void read_eos(JsonReader& sr, EquationOfState<Real>& eos) {
   er.finish();
 }
 
+// /solver/density_diffusion: {"kind": "none" | "molteni" | "fourtakas", "delta": 0.1}; needs the continuity
+// density (read before it).
+template <int Dim, class Real>
+void read_density_diffusion(JsonReader& sr, SolverConfig<Dim, Real>& cfg) {
+  if (!sr.has("density_diffusion")) return;
+  auto dr = sr.child("density_diffusion");
+  if (!dr.json().is_object()) dr.fail_here("expected an object, got " + json_value_text(dr.json()));
+  const std::string kind = dr.choice("kind", "none", {"none", "molteni", "fourtakas"});
+  cfg.density_diffusion.kind = *parse_density_diffusion(kind);
+  cfg.density_diffusion.delta =
+      static_cast<Real>(dr.number("delta", double(cfg.density_diffusion.delta), 0, 1));
+  if (cfg.density_diffusion.kind != DensityDiffusion::None &&
+      cfg.density_evolution != DensityEvolution::Continuity)
+    dr.fail("kind",
+            "\"" + kind + "\" diffuses an integrated density: needs /solver/density = \"continuity\"");
+  dr.finish();
+}
+
+// /solver/artificial_viscosity: {"alpha": 0.01, "walls": false}; WCSPH only.
+template <int Dim, class Real>
+void read_artificial_viscosity(JsonReader& sr, SolverConfig<Dim, Real>& cfg) {
+  if (!sr.has("artificial_viscosity")) return;
+  auto ar = sr.child("artificial_viscosity");
+  if (!ar.json().is_object()) ar.fail_here("expected an object, got " + json_value_text(ar.json()));
+  cfg.artificial_viscosity.alpha = static_cast<Real>(ar.number("alpha", 0, 0, 10));
+  cfg.artificial_viscosity.walls = ar.boolean("walls", false);
+  if (cfg.artificial_viscosity.alpha > 0 && cfg.model != Model::Wcsph)
+    ar.fail("alpha", "artificial viscosity is part of the WCSPH model (/solver/model = \"wcsph\")");
+  ar.finish();
+}
+
 template <int Dim, class Real>
 void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   cfg.support = static_cast<Real>(2 * spacing);
@@ -432,8 +465,17 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     kernels.emplace_back(kernel_name(k));
   cfg.density_kernel = *parse_kernel(sr.choice("density_kernel", "poly6", kernels));
   cfg.pressure_kernel = *parse_kernel(sr.choice("pressure_kernel", "spiky", kernels));
-  cfg.density = *parse_density_formulation(sr.choice("density", "mass", {"mass", "number"}));
+  const std::string density = sr.choice("density", "mass", {"mass", "number", "continuity"});
+  if (density == "continuity") {
+    if (cfg.model != Model::Wcsph)
+      sr.fail("density", "\"continuity\" needs the WCSPH model (/solver/model = \"wcsph\")");
+    cfg.density_evolution = DensityEvolution::Continuity;
+  } else {
+    cfg.density = *parse_density_formulation(density);
+  }
   read_eos(sr, cfg.eos);
+  read_density_diffusion(sr, cfg);
+  read_artificial_viscosity(sr, cfg);
   if (sr.has("gravity")) {
     const auto g = sr.vector("gravity", Dim, {});
     for (double c : g)

@@ -72,6 +72,22 @@ void SolverConfig<Dim, Real>::validate() const {
   }
   if (!(restitution >= 0 && restitution <= 1)) bad("restitution", restitution, "must be in [0, 1]");
   if (!(friction >= 0 && friction <= 1)) bad("friction", friction, "must be in [0, 1]");
+  if (density_evolution == DensityEvolution::Continuity && model != Model::Wcsph)
+    bad("density", "continuity", "the continuity equation needs the WCSPH model (model = wcsph)");
+  if (density_diffusion.kind != DensityDiffusion::None) {
+    if (density_evolution != DensityEvolution::Continuity)
+      bad("density_diffusion.kind", density_diffusion_name(density_diffusion.kind),
+          "diffuses an integrated density: needs density = continuity");
+    if (!(std::isfinite(density_diffusion.delta) && density_diffusion.delta >= 0 &&
+          density_diffusion.delta <= 1))
+      bad("density_diffusion.delta", density_diffusion.delta, "must be in [0, 1]");
+  }
+  if (!(std::isfinite(artificial_viscosity.alpha) && artificial_viscosity.alpha >= 0 &&
+        artificial_viscosity.alpha <= 10))
+    bad("artificial_viscosity.alpha", artificial_viscosity.alpha, "must be in [0, 10]");
+  if (artificial_viscosity.alpha > 0 && model != Model::Wcsph)
+    bad("artificial_viscosity.alpha", artificial_viscosity.alpha,
+        "artificial viscosity is part of the WCSPH model (model = wcsph)");
   if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
 }
 
@@ -139,6 +155,23 @@ std::string_view density_formulation_name(DensityFormulation d) {
 std::optional<DensityFormulation> parse_density_formulation(std::string_view n) {
   if (n == "mass") return DensityFormulation::Mass;
   if (n == "number") return DensityFormulation::Number;
+  return std::nullopt;
+}
+
+std::string_view density_diffusion_name(DensityDiffusion d) {
+  switch (d) {
+    case DensityDiffusion::None:
+      return "none";
+    case DensityDiffusion::Molteni:
+      return "molteni";
+    case DensityDiffusion::Fourtakas:
+      return "fourtakas";
+  }
+  return "?";
+}
+std::optional<DensityDiffusion> parse_density_diffusion(std::string_view n) {
+  for (auto d : {DensityDiffusion::None, DensityDiffusion::Molteni, DensityDiffusion::Fourtakas})
+    if (density_diffusion_name(d) == n) return d;
   return std::nullopt;
 }
 

@@ -41,6 +41,19 @@ enum class TensionModel {
   Akinci,
 };
 
+// How the WCSPH model obtains fluid densities (scene key solver.density).
+enum class DensityEvolution {
+  Summation,   // rho_i = sum_j m_j W_ij each step (models/summation_density.hpp)
+  Continuity,  // d rho_i / dt = sum_j m_j (v_i - v_j) . grad W_ij, integrated (models/continuity_density.hpp)
+};
+
+// Density diffusion added to the continuity equation (delta-SPH; models/continuity_density.hpp).
+enum class DensityDiffusion {
+  None,
+  Molteni,    // Molteni & Colagrossi 2009: delta h c0 times the SPH Laplacian of rho
+  Fourtakas,  // Fourtakas et al. 2019: the same on rho minus its hydrostatic part
+};
+
 enum class TimeStepping {
   Fixed,    // dt = time.dt every step (the paper's test)
   Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
@@ -103,9 +116,9 @@ struct SolverConfig {
   Model model = Model::PaperMultiphase;
 
   // Kernels. Density uses `density_kernel` (the paper: poly6), pressure the gradient of `pressure_kernel`
-  // (the paper: spiky); the WCSPH model also uses that gradient in Monaghan's viscosity operator. The
-  // paper's viscosity (eq. 8b) always uses the viscosity kernel's Laplacian, whose positivity it relies
-  // on, and the colour field always uses poly6 (eq. 8c).
+  // (the paper: spiky); the WCSPH model also uses that gradient in the laminar (Morris) and artificial
+  // (Monaghan) viscosities. The paper's viscosity (eq. 8b) always uses the viscosity kernel's Laplacian,
+  // whose positivity it relies on, and the colour field always uses poly6 (eq. 8c).
   KernelKind density_kernel = KernelKind::Poly6;
   KernelKind pressure_kernel = KernelKind::Spiky;
   Real support = Real(0.05);  // h [m]: kernel support and neighbour radius (paper eq. 14)
@@ -113,6 +126,22 @@ struct SolverConfig {
 
   EquationOfState<Real> eos{};
   std::vector<Phase<Real>> phases{Phase<Real>{}};
+
+  // WCSPH only: summation density or the continuity equation, with density diffusion (continuity only).
+  // `delta` is the dimensionless coefficient of the diffusion term delta h c0 lap(rho) (0.1 in both papers),
+  // h the smoothing length support / 2.
+  DensityEvolution density_evolution = DensityEvolution::Summation;
+  struct Diffusion {
+    DensityDiffusion kind = DensityDiffusion::None;
+    Real delta = Real(0.1);
+  } density_diffusion{};
+  // WCSPH only: Monaghan's (1992) artificial viscosity, alpha (dimensionless) with the sound speed c0 and
+  // the smoothing length support / 2, acting on approaching pairs only; off (alpha 0) by default, and not
+  // between fluid and wall particles unless `walls` (engineering codes leave it off there).
+  struct ArtificialViscosity {
+    Real alpha = 0;
+    bool walls = false;
+  } artificial_viscosity{};
 
   // |grad C| below which no interface tension acts (Mueller 2003's threshold l; the write-up's 7.065).
   Real tension_threshold = 0;
@@ -190,6 +219,8 @@ std::optional<StepChangeCorrection> parse_correction(std::string_view name);
 std::string_view wall_model_name(WallModel w);
 std::optional<WallModel> parse_wall_model(std::string_view name);
 std::string_view density_formulation_name(DensityFormulation d);
+std::string_view density_diffusion_name(DensityDiffusion d);
+std::optional<DensityDiffusion> parse_density_diffusion(std::string_view name);
 std::optional<DensityFormulation> parse_density_formulation(std::string_view name);
 
 extern template struct SolverConfig<2, float>;

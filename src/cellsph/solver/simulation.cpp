@@ -21,6 +21,7 @@
 #include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
+#include "cellsph/solver/models/continuity_density.hpp"
 #include "cellsph/solver/models/paper_multiphase.hpp"
 #include "cellsph/solver/models/summation_density.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
@@ -86,6 +87,12 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   complete(p_.phase, "phase", std::int32_t{0});
   complete(p_.kind, "kind", kFluid);
   p_.f.assign(n, V{});
+  // The continuity equation carries the density: a positive, finite input density of a fluid particle is
+  // its initial density (the scene's hydrostatic start gives each the state equation's density for its
+  // depth); otherwise, and always with summation density, the phase's rest density.
+  const bool carried_density = cfg_.density_evolution == DensityEvolution::Continuity;
+  std::vector<Real> rho_in;
+  if (carried_density && p_.rho.size() == n) rho_in = std::move(p_.rho);
   p_.rho.assign(n, Real(0));
   p_.p.assign(n, Real(0));
   p_.h.assign(n, cfg_.support);
@@ -126,6 +133,8 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
     const auto& phase = cfg_.phases[static_cast<std::size_t>(ph)];
     rho0_[i] = phase.rest_density;
     p_.rho[i] = phase.rest_density;
+    if (!rho_in.empty() && p_.kind[i] == kFluid && std::isfinite(rho_in[i]) && rho_in[i] > 0)
+      p_.rho[i] = rho_in[i];
     p_.color[i] = phase.color;
     p_.mu[i] = phase.viscosity;
     if (p_.kind[i] == kFluid) {
@@ -195,6 +204,7 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.f_pressure = f_pressure_.data();
   v.wall_v = wall_v_.data();
   v.wall_self_rho = wall_self_rho_.data();
+  v.drho = drho_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
   v.within = within_.data();
@@ -305,7 +315,10 @@ void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
   timings_.density_evals += set.size();
   vol_.resize(p_.size());
   prho2_.resize(p_.size());
-  summation_density(cfg_, view(), set);
+  if (cfg_.density_evolution == DensityEvolution::Continuity)
+    continuity_state(cfg_, view(), set);  // models/continuity_density.hpp
+  else
+    summation_density(cfg_, view(), set);
 }
 
 // Adami or dynamic walls: each wall particle's pressure, density (and no-slip velocity) from its fluid
@@ -363,7 +376,17 @@ void Simulation<Dim, Real>::integrate_paper(Real dt) {
 // The write-up's split with symplectic Euler (models/wcsph.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::integrate_wcsph(Real dt) {
-  run_pass(fluid_, WcsphSymplecticEulerPass<Dim, Real>{view(), dt});
+  if (cfg_.density_evolution == DensityEvolution::Summation) {
+    run_pass(fluid_, WcsphSymplecticEulerPass<Dim, Real>{view(), dt});
+    return;
+  }
+  // Continuity density: the kick, then d rho / dt with the new velocities at the old positions (the rows
+  // of this step), rho += dt d rho / dt, then the drift (models/continuity_density.hpp).
+  run_pass(fluid_, WcsphKickPass<Dim, Real>{view(), dt});
+  drho_.resize(p_.size());
+  continuity_rate(cfg_, view(), fluid_);
+  run_pass(fluid_, ContinuityIntegratePass<Dim, Real>{view(), dt});
+  run_pass(fluid_, WcsphDriftPass<Dim, Real>{view(), dt});
 }
 
 // The box and the planes (integration/collisions.hpp).
@@ -601,6 +624,11 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
       throw InputError(source + ": particle " + std::to_string(i) + " has time-step level " +
                        std::to_string(particles.level[i]) + " / tick " + std::to_string(particles.tick[i]) +
                        ", outside 0.." + std::to_string(cfg_.time.max_level) + " / 0..2^62");
+    // The continuity density is state: a fluid density of 0 or less would divide by zero in the next step.
+    if (particles.kind[i] == kFluid && cfg_.density_evolution == DensityEvolution::Continuity &&
+        !(particles.rho[i] > 0))
+      throw InputError(source + ": fluid particle " + std::to_string(i) + " has density " +
+                       std::to_string(particles.rho[i]) + " (the continuity density needs one > 0)");
     if (particles.kind[i] == kFluid) {
       lo_tick = std::min(lo_tick, particles.tick[i]);
       hi_tick = std::max(hi_tick, particles.tick[i]);

@@ -69,9 +69,10 @@ class Simulation {
   // inputs (id may be left empty or all 0: the input order; otherwise it must be a permutation of
   // 0..n-1; v, kind may be left empty: zero velocity, all fluid; m may be left empty or 0 for a fluid
   // particle: the phase's mass). support, colour and viscosity are set from the config and the phase table,
-  // density to the rest density; boundary particles with m == 0 get their Akinci weight psi_b in m (a
-  // positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick,
-  // m = rho0 spacing^Dim makes the wall look exactly like fluid).
+  // density to the rest density (with the continuity density, a fluid particle's positive, finite input
+  // density is kept as its initial density); boundary particles with m == 0 get their Akinci weight psi_b in
+  // m (a positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick, m =
+  // rho0 spacing^Dim makes the wall look exactly like fluid).
   Simulation(Config config, Particles<Dim, Real> particles);
 
   // One time step of the configured model (with per-particle steps: advances the particles whose own
@@ -179,6 +180,8 @@ class Simulation {
   // WallModel::Dynamic: sum_c m_c W_wc over the wall particles c within h of wall w (w itself included),
   // the constant part of w's summation density (walls never move); 0 for fluid slots.
   std::vector<Real> wall_self_rho_;
+  // WCSPH continuity density: d rho / dt of the step (models/continuity_density.hpp); read within the step.
+  std::vector<Real> drho_;
   // Indices of the fluid particles, ascending. Kinds never change, and reordering permutes particles
   // only among the slots of their own kind, so this list is fixed for a simulation.
   std::vector<std::uint32_t> fluid_;
