@@ -142,7 +142,7 @@ def main():
     os.makedirs("scenes/meshes", exist_ok=True)
     os.makedirs("data/meshes", exist_ok=True)
     d = "data/meshes/"
-    # The glass of the built-in scene water-glass: 0.1 m radius, 0.3 m tall, 48 segments, standing on z = 0.
+    # The glass of the built-in scene oil-glass: 0.1 m radius, 0.3 m tall, 48 segments, standing on z = 0.
     gv, gt = cylinder(48, 0.1, 0.3)
     obj("scenes/meshes/glass.obj", gv, gt)
     # The pier of the built-in scene dam-break-pier: an icosphere (level 2) of radius 0.1 m.
