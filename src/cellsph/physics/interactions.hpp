@@ -33,6 +33,13 @@ CELLSPH_HD inline Real density_term(const Kernel& w, Real mj, Real r2) {
   return mj * w.W2(r2);
 }
 
+// The continuity equation's rate of density change (DFSPH's density prediction and divergence):
+// D rho_i / Dt = sum_j m_j v_ij . grad W_ij; a wall particle enters with its weight psi_b and v_j = 0.
+template <int Dim, class Real>
+CELLSPH_HD inline Real continuity_term(const Vec<Dim, Real>& grad_w, Real mj, const Vec<Dim, Real>& vij) {
+  return mj * dot(vij, grad_w);
+}
+
 // ---- The paper's averaged forces (eq. 8a, 8b) --------------------------------------------------
 
 // eq. 8a: -V_i V_j (P_i + P_j)/2 grad W^press. Antisymmetric in i and j, so momentum is conserved.

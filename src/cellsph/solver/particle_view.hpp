@@ -52,6 +52,9 @@ struct ParticleView {
   V* f_pressure = nullptr;        // WCSPH: pressure force, applied after the predicted velocity
   V* wall_v = nullptr;            // Adami: extrapolated no-slip velocity of a wall particle
   Real* wall_self_rho = nullptr;  // dynamic walls: the fixed wall-wall part of the density
+  Real* df_alpha = nullptr;       // DFSPH (models/dfsph.hpp): 1 / (the factor's denominator)
+  Real* df_kappa = nullptr;       // DFSPH: this sweep's pressure / rho^2 increment
+  Real* df_kappa_v = nullptr;     // DFSPH: the divergence solve's pressure / rho^2 (warm start)
 
   // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +
   // 1]. The rows cut to h (filter_rows): within + offsets[i], within_count[i] long; the pair passes read
