@@ -198,6 +198,7 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.df_alpha = df_alpha_.data();
   v.df_kappa = df_kappa_.data();
   v.df_kappa_v = df_kappa_v_.data();
+  v.df_grad = df_grad_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
   v.within = within_.data();
@@ -535,6 +536,7 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   df_alpha_.resize(n);
   df_kappa_.resize(n);
   df_kappa_v_.resize(n, Real(0));
+  df_grad_.resize(nl_.indices.size());
   if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
   const Real dt = dfsph_step(cfg_, view(), fluid_, df_diameter_, dfsph_stats_, steps_ + 1);
   timings_.forces += sw.ms();

@@ -216,6 +216,7 @@ class Simulation {
   // solve's accumulated k is its next warm start (kept across steps, permuted by reorders; not in a
   // checkpoint, so a resumed run restarts that warm start from 0).
   std::vector<Real> df_alpha_, df_kappa_, df_kappa_v_;
+  std::vector<V> df_grad_;  // per pair slot of the rows (nl_.indices.size()): the step's kernel gradients
   Real df_diameter_ = 0;
   DfsphStats dfsph_stats_;
 };

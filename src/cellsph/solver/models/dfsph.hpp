@@ -57,15 +57,15 @@ struct DfsphStats {
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
 };
 
-// D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, at rest), over i's rows.
-template <int Dim, class Real, class Kernel>
-CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, const Kernel& w, std::size_t i) {
-  const Vec<Dim, Real> xi = pv.x[i], vi = pv.v[i];
+// D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, at rest), over i's rows, with the step's
+// gradients (df_grad, written by the density pass).
+template <int Dim, class Real>
+CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i) {
+  const Vec<Dim, Real> vi = pv.v[i];
   Real d = 0;
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
     const std::uint32_t j = *it;
-    const Vec<Dim, Real> g = w.gradW(xi - pv.x[j]);
-    d += continuity_term(g, pv.m[j], pv.is_fluid(j) ? vi - pv.v[j] : vi);
+    d += continuity_term(pv.df_grad[it - pv.within], pv.m[j], pv.is_fluid(j) ? vi - pv.v[j] : vi);
   }
   return d;
 }
@@ -90,7 +90,9 @@ struct DfsphDensityFactorPass {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
       rho += density_term(w, pv.m[j], norm2(xij));
-      const V mg = w.gradW(xij) * pv.m[j];
+      const V g = w.gradW(xij);
+      pv.df_grad[it - pv.within] = g;  // the step's gradients, read by every sweep (positions fixed)
+      const V mg = g * pv.m[j];
       grad += mg;
       if (pv.is_fluid(j)) sq += norm2(mg);
     }
@@ -117,7 +119,7 @@ struct DfsphSourcePass {
   std::uint32_t min_neighbors;  // divergence: fewer neighbours, no correction (splashes)
 
   CELLSPH_HD Real operator()(std::size_t i) const {
-    const Real rate = dfsph_density_rate(pv, w, i);
+    const Real rate = dfsph_density_rate(pv, i);
     const Real rho0 = pv.rho0[i];
     Real source = 0;
     if (density) {
@@ -145,13 +147,12 @@ struct DfsphPressureKickPass {
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
-    const V xi = pv.x[i];
     const Real mi = pv.m[i], ki = pv.df_kappa[i];
     V f{};
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
-      const V g = w.gradW(xi - pv.x[j]);
-      f += symmetric_pressure_force(g, mi, pv.m[j], ki, pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
+      f += symmetric_pressure_force(pv.df_grad[it - pv.within], mi, pv.m[j], ki,
+                                    pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
     }
     pv.v[i] += f * (dt / mi);
     acc[i] += ki;
@@ -178,10 +179,10 @@ struct DfsphNonPressurePass {
       const Real r = norm(xij);
       if (pv.is_fluid(j)) {
         const Real q = monaghan_quotient(vi - pv.v[j], xij, r, eps2);
-        f += monaghan_viscosity_force(w.gradW(xij), vol_i, pv.vol[j], mui, pv.mu[j], q);
+        f += monaghan_viscosity_force(pv.df_grad[it - pv.within], vol_i, pv.vol[j], mui, pv.mu[j], q);
       } else if (no_slip) {
         const Real q = monaghan_quotient(vi, xij, r, eps2);
-        f += monaghan_viscosity_force(w.gradW(xij), vol_i, pv.m[j] / rhoi, mui, mui, q);
+        f += monaghan_viscosity_force(pv.df_grad[it - pv.within], vol_i, pv.m[j] / rhoi, mui, mui, q);
       }
     }
     pv.f[i] = f;
