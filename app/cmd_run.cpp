@@ -114,6 +114,18 @@ void reject_old_checkpoint(const std::filesystem::path& file) {
                      "run the scene again");
 }
 
+// DFSPH's part of the progress line: sweeps of the last step (density / divergence), its average
+// density error and step.
+template <int Dim, class Real>
+std::string dfsph_progress(const Simulation<Dim, Real>& sim) {
+  if (sim.config().model != Model::Dfsph) return "";
+  const auto& st = sim.dfsph_stats();
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "  dfsph %d+%d sweeps, err %.3f%%, dt %.3g ms", st.last_density_iterations,
+                st.last_divergence_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
+  return buf;
+}
+
 std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
@@ -345,7 +357,8 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
       progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
                                 " s  frame " + std::to_string(loop.next_frame) + "  " +
                                 fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
-                                " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles");
+                                " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles" +
+                                dfsph_progress(sim));
     }
   } catch (...) {
     progress.finish();  // the error's line starts on a line of its own
@@ -391,6 +404,20 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
         steps ? (double(sim.time()) - t_at_start) / double(steps) : 0.0,
         static_cast<unsigned long long>(loop.next_frame), out.string().c_str(), pct(tm.neighbors).c_str(),
         pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
+    if (cfg.model == Model::Dfsph) {
+      const auto& st = sim.dfsph_stats();
+      const double n = double(std::max<std::uint64_t>(st.steps, 1));
+      std::fprintf(stderr,
+                   "         dfsph: %.2f density + %.2f divergence sweeps/step, density error last %.3g%% "
+                   "max %.3g%% (bound %.3g%%), %llu solves stopped at max_iterations%s\n",
+                   double(st.density_iterations) / n, double(st.divergence_iterations) / n,
+                   st.last_density_error, st.max_density_error, double(cfg.dfsph.max_density_error),
+                   static_cast<unsigned long long>(st.max_iteration_hits),
+                   st.max_iteration_hits ? (" (last: step " + std::to_string(st.last_hit_step) + ", error " +
+                                            fmt("%.3g", st.last_hit_error) + "%)")
+                                               .c_str()
+                                         : "");
+    }
   }
   return 0;
 }

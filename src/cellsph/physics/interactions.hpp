@@ -34,9 +34,9 @@ CELLSPH_HD inline Real density_term(const Kernel& w, Real mj, Real r2) {
   return mj * w.W2(r2);
 }
 
-// The continuity equation (WCSPH, density = continuity): d rho_i / dt = sum_j m_j (v_i - v_j) . grad W_ij,
-// the exact time derivative of the summation sum_j m_j W_ij over the same neighbours (walls included, with
-// their weights and velocities), so on a lattice at rest both agree for all time.
+// The continuity equation: d rho_i / dt = sum_j m_j (v_i - v_j) . grad W_ij, the exact time derivative of the
+// summation sum_j m_j W_ij over the same neighbours. WCSPH's continuity density (walls with their weights and
+// velocities) and DFSPH's density prediction and divergence (a wall enters with psi_b and v_j = 0) call it.
 template <int Dim, class Real>
 CELLSPH_HD inline Real continuity_term(const Vec<Dim, Real>& grad_w, Real mj, const Vec<Dim, Real>& vij) {
   return mj * dot(vij, grad_w);

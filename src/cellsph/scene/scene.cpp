@@ -454,7 +454,8 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     return;
   }
   auto sr = r.child("solver");
-  cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph"}));
+  cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph", "dfsph"}));
+  if (cfg.model == Model::Dfsph) cfg.time.courant = Real(0.4);  // on the particle diameter (models/dfsph.hpp)
   cfg.support = static_cast<Real>(sr.number("support", 2 * spacing, 1e-9, 1e9));
   if (cfg.support < static_cast<Real>(spacing))
     sr.fail("support", "value " + std::to_string(cfg.support) + " is smaller than the particle spacing " +
@@ -487,6 +488,22 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf", "akinci"}));
   cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
   cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
+  if (sr.has("dfsph")) {
+    auto dr = sr.child("dfsph");
+    if (cfg.model != Model::Dfsph) dr.fail_here("is read only with /solver/model = \"dfsph\"");
+    auto& d = cfg.dfsph;
+    d.max_density_error =
+        static_cast<Real>(dr.number("max_density_error", double(d.max_density_error), 1e-9, 100));
+    d.max_divergence_error =
+        static_cast<Real>(dr.number("max_divergence_error", double(d.max_divergence_error), 1e-9, 100));
+    d.min_iterations = static_cast<int>(dr.integer("min_iterations", d.min_iterations, 0, 100000));
+    d.max_iterations = static_cast<int>(dr.integer("max_iterations", d.max_iterations, 1, 100000));
+    d.warm_start = dr.boolean("warm_start", d.warm_start);
+    if (d.min_iterations > d.max_iterations)
+      dr.fail("min_iterations", "value " + std::to_string(d.min_iterations) + " exceeds max_iterations " +
+                                    std::to_string(d.max_iterations));
+    dr.finish();
+  }
   sr.finish();
 }
 

@@ -18,6 +18,7 @@ namespace cellsph {
 enum class Model {
   PaperMultiphase,  // Onderik & Durikovic 2007, Algorithm 1: eq. 7-9, leap-frog eq. 11
   Wcsph,            // the CUDA write-up: operator splitting, symmetric pressure, symplectic Euler
+  Dfsph,            // Bender & Koschier 2015/2017: divergence-free SPH, implicit pressure (models/dfsph.hpp)
 };
 
 // How the paper's model obtains densities of neighbours of another phase.
@@ -183,6 +184,18 @@ struct SolverConfig {
   // box above is used when enabled, otherwise the escape test is off.
   bool domain_set = false;
   V domain_lo{}, domain_hi{};
+
+  // Model::Dfsph (models/dfsph.hpp). Errors in percent, as SPlisHSPlasH takes them: the average density
+  // error of the constant-density solver in % of the rest density, the average divergence error of the
+  // divergence-free solver in % of the rest density per step. min_iterations is the constant-density
+  // solver's minimum (the divergence-free solver makes at least one sweep); both stop at max_iterations.
+  struct Dfsph {
+    Real max_density_error = Real(0.05);
+    Real max_divergence_error = Real(0.1);
+    int min_iterations = 2;
+    int max_iterations = 100;
+    bool warm_start = true;
+  } dfsph{};
 
   SearchOptions search{};
   // Verlet lists: the search runs at h (1 + verlet_skin) and its lists are kept until a particle has moved

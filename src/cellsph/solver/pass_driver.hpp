@@ -50,6 +50,28 @@ Result reduce_max(const IndexSet& set, Result init, const Pass& pass) {
   return r;
 }
 
+// The sum of pass(i) over `set`, in double, independent of the thread count: the set is cut into fixed
+// blocks of 1024 entries, each summed in order, and the block sums are added in order (a plain
+// per-thread partial sum would change in the last bits with the thread count).
+template <class Pass>
+double reduce_sum(const IndexSet& set, const Pass& pass) {
+  constexpr std::size_t kBlock = 1024;
+  const std::size_t blocks = (set.size() + kBlock - 1) / kBlock;
+  std::vector<double> partial(blocks, 0.0);
+  const std::uint32_t* idx = set.data();
+  const std::size_t n = set.size();
+  parallel_for(blocks, [&](std::size_t b) {
+    double s = 0;
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    for (std::size_t k = b * kBlock; k < end; ++k)
+      s += static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
+    partial[b] = s;
+  });
+  double s = 0;
+  for (const double q : partial) s += q;
+  return s;
+}
+
 // The lowest index i of `set` with pred(i) true, or -1 if none (deterministic: a minimum).
 template <class Pred>
 std::int64_t first_where(const IndexSet& set, const Pred& pred) {

@@ -205,6 +205,10 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.wall_v = wall_v_.data();
   v.wall_self_rho = wall_self_rho_.data();
   v.drho = drho_.data();
+  v.df_alpha = df_alpha_.data();
+  v.df_kappa = df_kappa_.data();
+  v.df_kappa_v = df_kappa_v_.data();
+  v.df_grad = df_grad_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
   v.within = within_.data();
@@ -273,6 +277,7 @@ void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
   permute(prho2_);
   permute(f_pressure_);
   permute(normal_);
+  permute(df_kappa_v_);
   lists_valid_ = false;  // x_built_ and the lists name the old slots
 }
 
@@ -517,6 +522,10 @@ void Simulation<Dim, Real>::step() {
 
   sw.reset();
   filter_lists(fluid_);
+  if (cfg_.model == Model::Dfsph) {
+    step_dfsph(sw);
+    return;
+  }
   compute_density_pressure(fluid_);
   if (wall_states_) compute_wall_states();
   if (cfg_.model == Model::PaperMultiphase)
@@ -531,6 +540,30 @@ void Simulation<Dim, Real>::step() {
     integrate_paper(dt);
   else
     integrate_wcsph(dt);
+  apply_walls();
+  check_state();
+  time_ += dt;
+  last_dt_ = dt;
+  ++steps_;
+  timings_.integration += sw.ms();
+}
+
+// The rest of a DFSPH step after the rows (models/dfsph.hpp), then the walls and the check.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
+  const std::size_t n = p_.size();
+  timings_.density_evals += fluid_.size();
+  timings_.force_evals += fluid_.size();
+  vol_.resize(n);
+  prho2_.resize(n);
+  df_alpha_.resize(n);
+  df_kappa_.resize(n);
+  df_kappa_v_.resize(n, Real(0));
+  df_grad_.resize(nl_.indices.size());
+  if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
+  const Real dt = dfsph_step(cfg_, view(), fluid_, df_diameter_, dfsph_stats_, steps_ + 1);
+  timings_.forces += sw.ms();
+  sw.reset();
   apply_walls();
   check_state();
   time_ += dt;
@@ -649,6 +682,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   }
   fluid_count_ = fluid_.size();
   lists_valid_ = false;
+  df_kappa_v_.clear();
   // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
   // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
   // the file's fault, named as such (the Simulation is then not usable; the caller stops).

@@ -1,9 +1,10 @@
 #pragma once
 // The SPH solver: one object owns the particles, the configuration and the neighbour search, and advances
-// them by step(). Two models (config.model):
+// them by step(). Three models (config.model):
 //  * PaperMultiphase: Onderik & Durikovic 2007, Algorithm 1 (density eq. 7, Tait, averaged forces eq. 8a-b,
 //    colour field and interface tension eq. 8c/9, leap-frog eq. 11).
 //  * Wcsph: the CUDA write-up's weakly compressible SPH with operator splitting and symplectic Euler.
+//  * Dfsph: Bender & Koschier's divergence-free SPH, pressure solved implicitly (models/dfsph.hpp).
 //
 // Velocities: in the paper's model particles().v holds the leap-frog half-step velocity v(t - dt/2) once
 // the first step has run (eq. 11); in the WCSPH model it is v(t).
@@ -25,10 +26,12 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/core/timer.hpp"
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/config.hpp"
+#include "cellsph/solver/models/dfsph.hpp"
 #include "cellsph/solver/particle_view.hpp"
 #include "cellsph/solver/particles.hpp"
 #include "cellsph/solver/pass_driver.hpp"
@@ -91,6 +94,8 @@ class Simulation {
   [[nodiscard]] const StepTimings& timings() const { return timings_; }
   [[nodiscard]] const SearchStats& search_stats() const { return search_.stats(); }
   [[nodiscard]] std::size_t fluid_count() const { return fluid_count_; }
+  // Model::Dfsph: iterations and errors of the pressure solves (models/dfsph.hpp).
+  [[nodiscard]] const DfsphStats& dfsph_stats() const { return dfsph_stats_; }
 
   // Diagnostics over fluid particles.
   [[nodiscard]] V momentum() const;
@@ -146,6 +151,7 @@ class Simulation {
   void check_state();
   void init_boundary_weights();
   void step_per_particle();
+  void step_dfsph(Stopwatch& sw);
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
   // ties by id; every per-particle array is permuted and the Verlet lists invalidated.
   void reorder_slots(const IndexList& slots);
@@ -208,6 +214,14 @@ class Simulation {
   bool leapfrog_started_ = false;  // v holds v(t - dt/2)
 
   StepTimings timings_;
+
+  // Model::Dfsph (models/dfsph.hpp): alpha and the sweep's k are rebuilt each step; the divergence
+  // solve's accumulated k is its next warm start (kept across steps, permuted by reorders; not in a
+  // checkpoint, so a resumed run restarts that warm start from 0).
+  std::vector<Real> df_alpha_, df_kappa_, df_kappa_v_;
+  std::vector<V> df_grad_;  // per pair slot of the rows (nl_.indices.size()): the step's kernel gradients
+  Real df_diameter_ = 0;
+  DfsphStats dfsph_stats_;
 };
 
 extern template class Simulation<2, float>;

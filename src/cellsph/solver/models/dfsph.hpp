@@ -1,0 +1,332 @@
+#pragma once
+// Divergence-free SPH (Bender & Koschier, SCA 2015 and TVCG 2017; Model::Dfsph): an incompressible model
+// whose pressure is solved implicitly, so that the step is limited by the flow speed (CFL) rather than by
+// an artificial speed of sound. One step, on the rows of the fluid particles (cut to h):
+//  1. DfsphDensityFactorPass: summation density (fluid m_j W_ij plus Akinci 2012 walls psi_b W_ib) and
+//     the factor alpha_i = 1 / (|sum_j m_j grad W_ij + sum_b psi_b grad W_ib|^2 + sum_j |m_j grad W_ij|^2);
+//  2. the step: dt = min(dt_max, courant * d / max |v|, viscous * h^2 / nu) with d the particle
+//     diameter (V^(1/Dim)), or time.dt when the stepping is fixed;
+//  3. the divergence-free solve: Jacobi sweeps on k_i = p_i / rho_i^2 until the average of
+//     max(D rho_i / Dt, 0) dt / rho0 is at most max_divergence_error (percent);
+//  4. the non-pressure forces (gravity, the laminar viscosity of Morris et al. 1997, physics/interactions.hpp) and v* = v + dt f/m;
+//  5. the constant-density solve: Jacobi sweeps until the average of max(rho*_i - rho0, 0) / rho0, with
+//     rho*_i = rho_i + dt D rho_i / Dt, is at most max_density_error (percent);
+//  6. x += dt v, p_i = k_i rho_i^2 (the density solve's pressure, also its next warm start).
+// A sweep sets k_i = max(source_i, 0) alpha_i / dt^2 (density; / dt for the divergence) and changes
+// v_i by -dt sum_j m_j (k_i + k_j) grad W_ij - dt sum_b psi_b k_i grad W_ib (symmetric_pressure_force with
+// the wall's k = 0: the gradient of i's density constraint, so alpha_i is exactly the Jacobi diagonal).
+// Warm starts (2017 paper): each solve begins with half of the last step's k where the particle is
+// compressed. Every pass writes only its own particle's entries; the error averages are reduce_sum
+// (pass_driver.hpp), whose result does not depend on the thread count.
+//
+// The density uses the density kernel, and so do its gradient (the time derivative of that density) and
+// the viscosity's gradient: pressure_kernel is not read by this model.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <type_traits>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/hd.hpp"
+#include "cellsph/core/timer.hpp"
+#include "cellsph/physics/interactions.hpp"
+#include "cellsph/physics/kernels.hpp"
+#include "cellsph/solver/config.hpp"
+#include "cellsph/solver/particle_view.hpp"
+#include "cellsph/solver/pass_driver.hpp"
+#include "cellsph/solver/timestep/global_courant.hpp"
+
+namespace cellsph {
+
+// What the DFSPH solves did, for the progress line, tests and benchmarks.
+struct DfsphStats {
+  std::uint64_t steps = 0;
+  std::uint64_t density_iterations = 0;     // sweeps of the constant-density solver, summed over steps
+  std::uint64_t divergence_iterations = 0;  // sweeps of the divergence-free solver, summed over steps
+  int last_density_iterations = 0;
+  int last_divergence_iterations = 0;
+  double last_density_error = 0;         // average density error reached in the last step [% of rho0]
+  double last_divergence_error = 0;      // average divergence error reached in the last step [% per step]
+  double max_density_error = 0;          // the largest of last_density_error over the steps
+  std::uint64_t max_iteration_hits = 0;  // solves stopped by max_iterations above their error bound
+  std::uint64_t last_hit_step = 0;       // the step (1-based) of the last such solve
+  double last_hit_error = 0;             // and the error [%] it reached
+  double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
+};
+
+// D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, at rest), over i's rows, with the step's
+// gradients (df_grad, written by the density pass).
+template <int Dim, class Real>
+CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i) {
+  const Vec<Dim, Real> vi = pv.v[i];
+  Real d = 0;
+  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+    const std::uint32_t j = *it;
+    d += continuity_term(pv.df_grad[it - pv.within], pv.m[j], pv.is_fluid(j) ? vi - pv.v[j] : vi);
+  }
+  return d;
+}
+
+// Step 1: density, volume, alpha, and the density solve's warm start k = p / rho^2 of the last step
+// (read before rho is overwritten; p and rho are particle fields, so a checkpoint carries it).
+template <int Dim, class Real, class Kernel>
+struct DfsphDensityFactorPass {
+  ParticleView<Dim, Real> pv;
+  Kernel w;
+  Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    using V = Vec<Dim, Real>;
+    const Real rho_old = pv.rho[i];
+    const Real warm = rho_old > 0 ? pv.p[i] / (rho_old * rho_old) : Real(0);
+    const V xi = pv.x[i];
+    Real rho = density_term(w, pv.m[i], Real(0));
+    V grad{};
+    Real sq = 0;
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+      const std::uint32_t j = *it;
+      const V xij = xi - pv.x[j];
+      rho += density_term(w, pv.m[j], norm2(xij));
+      const V g = w.gradW(xij);
+      pv.df_grad[it - pv.within] = g;  // the step's gradients, read by every sweep (positions fixed)
+      const V mg = g * pv.m[j];
+      grad += mg;
+      if (pv.is_fluid(j)) sq += norm2(mg);
+    }
+    const Real denom = norm2(grad) + sq;
+    pv.rho[i] = rho;
+    pv.vol[i] = pv.m[i] / rho;
+    pv.df_alpha[i] = denom > denom_floor ? Real(1) / denom : Real(0);
+    pv.prho2[i] = warm;
+  }
+};
+
+// The source of a sweep: writes k_i = source * alpha / dt^2 (density) or / dt (divergence) to df_kappa
+// and returns i's error (relative to rho0; per step for the divergence). In warm mode instead: k_i = half
+// the accumulated k where the source is positive (0 elsewhere), and the accumulator restarts at 0.
+template <int Dim, class Real, class Kernel>
+struct DfsphSourcePass {
+  ParticleView<Dim, Real> pv;
+  Kernel w;
+  Real dt;
+  bool density;                 // constant-density solve (else divergence-free)
+  bool warm;                    // warm-start mode
+  Real warm_scale;              // 0.5, or 0 without warm starts
+  Real* acc;                    // the solve's accumulated k: pv.prho2 (density) or pv.df_kappa_v (divergence)
+  std::uint32_t min_neighbors;  // divergence: fewer neighbours, no correction (splashes)
+
+  CELLSPH_HD Real operator()(std::size_t i) const {
+    const Real rate = dfsph_density_rate(pv, i);
+    const Real rho0 = pv.rho0[i];
+    Real source = 0;
+    if (density) {
+      source = std::max(pv.rho[i] + dt * rate - rho0, Real(0));
+    } else if (pv.within_count[i] >= min_neighbors) {
+      source = std::max(rate, Real(0));
+    }
+    if (warm) {
+      pv.df_kappa[i] = source > 0 ? warm_scale * acc[i] : Real(0);
+      acc[i] = 0;
+      return 0;
+    }
+    pv.df_kappa[i] = density ? source * pv.df_alpha[i] / (dt * dt) : source * pv.df_alpha[i] / dt;
+    return density ? source / rho0 : source * dt / rho0;
+  }
+};
+
+// A sweep's velocity change from the k of the source pass; adds k_i to the accumulator.
+template <int Dim, class Real, class Kernel>
+struct DfsphPressureKickPass {
+  ParticleView<Dim, Real> pv;
+  Kernel w;
+  Real dt;
+  Real* acc;
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    using V = Vec<Dim, Real>;
+    const Real mi = pv.m[i], ki = pv.df_kappa[i];
+    V f{};
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+      const std::uint32_t j = *it;
+      f += symmetric_pressure_force(pv.df_grad[it - pv.within], mi, pv.m[j], ki,
+                                    pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
+    }
+    pv.v[i] += f * (dt / mi);
+    acc[i] += ki;
+  }
+};
+
+// Step 4: the non-pressure forces, as the WCSPH model's (models/wcsph.hpp) without pressure and tension.
+template <int Dim, class Real, class Kernel>
+struct DfsphNonPressurePass {
+  ParticleView<Dim, Real> pv;
+  Kernel w;
+  Vec<Dim, Real> gravity;
+  Real eta2;  // the laminar operator's regulariser 0.01 h_s^2 (h_s = support / 2), as in models/wcsph.hpp
+  bool no_slip;
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    using V = Vec<Dim, Real>;
+    const V xi = pv.x[i], vi = pv.v[i];
+    const Real vol_i = pv.vol[i], mui = pv.mu[i], rhoi = pv.rho[i];
+    V f = gravity * pv.m[i];
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+      const std::uint32_t j = *it;
+      const V xij = xi - pv.x[j];
+      const Real r = norm(xij);
+      const V g = pv.df_grad[it - pv.within];
+      if (pv.is_fluid(j))
+        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
+      else if (no_slip)
+        f += morris_viscosity_force(vi, g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
+    }
+    pv.f[i] = f;
+  }
+};
+
+template <int Dim, class Real>
+struct DfsphKickPass {
+  ParticleView<Dim, Real> pv;
+  Real dt;
+  CELLSPH_HD void operator()(std::size_t i) const { pv.v[i] += pv.f[i] * (dt / pv.m[i]); }
+};
+
+// Step 6.
+template <int Dim, class Real>
+struct DfsphDriftPass {
+  ParticleView<Dim, Real> pv;
+  Real dt;
+  CELLSPH_HD void operator()(std::size_t i) const {
+    pv.x[i] += pv.v[i] * dt;
+    pv.p[i] = pv.prho2[i] * pv.rho[i] * pv.rho[i];
+  }
+};
+
+struct DfsphSolveResult {
+  int iterations = 0;
+  double error = 0;  // relative (not percent)
+};
+
+// One solve (density or divergence): warm start, then sweeps until the average error is at most eta
+// (relative) after at least min_it sweeps, or max_it sweeps were made.
+template <int Dim, class Real, class Kernel>
+DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const IndexSet& set, const Kernel& w, Real dt,
+                             bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
+                             std::uint32_t min_neighbors) {
+  const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc};
+  // Half the last step's k, as SPlisHSPlasH: the full sum (measured) set the hydrostatic column and the
+  // dam break ringing.
+  run_pass(set, DfsphSourcePass<Dim, Real, Kernel>{pv, w, dt, density, true, Real(warm_start ? 0.5 : 0.0),
+                                                   acc, min_neighbors});
+  if (warm_start) run_pass(set, kick);
+  const DfsphSourcePass<Dim, Real, Kernel> source{pv, w, dt, density, false, Real(0), acc, min_neighbors};
+  const double n = static_cast<double>(std::max<std::size_t>(set.size(), 1));
+  DfsphSolveResult r;
+  for (;;) {
+    r.error = reduce_sum(set, source) / n;
+    if (!std::isfinite(r.error)) return r;
+    if ((r.iterations >= min_it && r.error <= eta) || r.iterations >= max_it) return r;
+    run_pass(set, kick);
+    ++r.iterations;
+  }
+}
+
+// The particle diameter d = min over fluid particles of (m / rho0)^(1/Dim) (host, once per run).
+template <int Dim, class Real>
+Real dfsph_particle_diameter(const ParticleView<Dim, Real>& pv, const IndexSet& fluid) {
+  Real vmin = std::numeric_limits<Real>::max();
+  for (const std::uint32_t i : fluid) vmin = std::min(vmin, pv.m[i] / pv.rho0[i]);
+  return fluid.empty() ? Real(0) : static_cast<Real>(std::pow(double(vmin), 1.0 / Dim));
+}
+
+// One DFSPH step of the particles of `fluid` (rows filtered to h, pv's DFSPH arrays sized for every
+// particle). Returns dt. Throws SimulationError when a solve's error is not finite. `step` is the number of
+// the step being taken (1-based), for messages.
+template <int Dim, class Real>
+Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& fluid,
+                Real diameter, DfsphStats& st, std::uint64_t step) {
+  const Real h = cfg.support;
+  Real rho0_min = std::numeric_limits<Real>::max(), nu_max = 0;
+  for (const auto& ph : cfg.phases) {
+    rho0_min = std::min(rho0_min, ph.rest_density);
+    nu_max = std::max(nu_max, ph.viscosity / ph.rest_density);
+  }
+  // A full neighbourhood holds about the support's volume over the particle volume; the divergence solve
+  // leaves particles with fewer than 60% of that alone (SPlisHSPlasH's 20 of about 33 in 3D).
+  const double ratio = double(h) / double(diameter);
+  const double full = Dim == 3 ? 4.18879 * ratio * ratio * ratio : 3.14159 * ratio * ratio;
+  const auto min_neighbors = static_cast<std::uint32_t>(0.6 * full);
+  const double eta_density = double(cfg.dfsph.max_density_error) / 100;
+  const double eta_divergence = double(cfg.dfsph.max_divergence_error) / 100;
+
+  Real dt = 0;
+  with_kernel<Dim, Real>(cfg.density_kernel, h, [&](const auto w) {
+    using K = std::remove_cvref_t<decltype(w)>;
+    Stopwatch sw;
+    const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
+    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor});
+    // The step from the velocities at its start.
+    if (cfg.time.mode == TimeStepping::Fixed) {
+      dt = cfg.time.dt;
+    } else {
+      dt = cfg.time.dt_max;
+      const auto mx = reduce_max(fluid, CourantMaxima<Real>{}, CourantLimitsPass<Dim, Real>{pv, false});
+      if (mx.v2 > 0) dt = std::min(dt, cfg.time.courant * diameter / std::sqrt(mx.v2));
+      // Explicit viscosity: the limit on the particle spacing, not the support (measured: on h = 2 d
+      // the hydrostatic column at mu = 20 Pa s grew unstable at 0.4x the h-based limit).
+      if (nu_max > 0) dt = std::min(dt, cfg.time.viscous * diameter * diameter / nu_max);
+    }
+    st.ms_factor += sw.ms();
+    sw.reset();
+
+    auto check = [&](const DfsphSolveResult& r, double eta, const char* what) {
+      if (!std::isfinite(r.error)) {
+        std::ostringstream os;
+        os << "simulation unstable at step " << step << ": the DFSPH " << what
+           << " solve diverged (average error not finite after " << r.iterations << " sweeps, dt = " << dt
+           << " s)";
+        throw SimulationError(os.str());
+      }
+      if (r.error > eta) {
+        ++st.max_iteration_hits;
+        st.last_hit_step = step;
+        st.last_hit_error = r.error * 100;
+      }
+    };
+    const DfsphSolveResult div = dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1,
+                                             cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors);
+    check(div, eta_divergence, "divergence-free");
+    st.ms_divergence += sw.ms();
+    sw.reset();
+
+    run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2), cfg.no_slip});
+    run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
+    st.ms_nonpressure += sw.ms();
+    sw.reset();
+
+    const DfsphSolveResult den =
+        dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
+                    cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors);
+    check(den, eta_density, "constant-density");
+    st.ms_density += sw.ms();
+    sw.reset();
+
+    run_pass(fluid, DfsphDriftPass<Dim, Real>{pv, dt});
+    st.ms_drift += sw.ms();
+
+    ++st.steps;
+    st.divergence_iterations += static_cast<std::uint64_t>(div.iterations);
+    st.density_iterations += static_cast<std::uint64_t>(den.iterations);
+    st.last_divergence_iterations = div.iterations;
+    st.last_density_iterations = den.iterations;
+    st.last_divergence_error = div.error * 100;
+    st.last_density_error = den.error * 100;
+    st.max_density_error = std::max(st.max_density_error, st.last_density_error);
+  });
+  return dt;
+}
+
+}  // namespace cellsph
