@@ -237,7 +237,7 @@ def test_simulation_error_is_a_runtime_error():
 
 def test_host_device_backend_gives_the_cpu_bits():
     # "host-device": the CUDA backend's code path (device arrays, copies, the sorted grid) on the CPU.
-    s = cellsph.Scene.load("dam-break-2d").set("/spacing", 0.05)
+    s = cellsph.Scene.load("dam-break-2d").set("/solver/support", 0.1).set("/spacing", 0.05)
     cpu = cellsph.Simulation(s, threads=1)
     dev = cellsph.Simulation(s, threads=1, backend="host-device")
     cpu.step(5)
