@@ -300,6 +300,7 @@ struct SphArgs {
   std::string methods;
   std::string models = "wcsph,paper";
   std::string precisions = "float,double";
+  std::string backend = "cpu";
   int steps = 20;
   int warmup = 3;
   int threads = 2;
@@ -407,6 +408,10 @@ void run_bench_sph(const SphArgs& a) {
   for (const auto& p : precisions)
     if (p != "float" && p != "double")
       throw InputError("--precisions: unknown precision '" + p + "' (expected float,double)");
+  const auto backend = parse_backend(a.backend);
+  if (!backend) throw InputError("--backend: unknown backend '" + a.backend + "' (expected cpu or cuda)");
+  require_backend(*backend, "--backend");
+  const bool on_device = *backend != Backend::Cpu;
   if (a.steps < 1) throw InputError("--steps: must be >= 1, got " + std::to_string(a.steps));
   if (a.warmup < 0) throw InputError("--warmup: must be >= 0, got " + std::to_string(a.warmup));
   if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
@@ -438,27 +443,34 @@ void run_bench_sph(const SphArgs& a) {
       "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
       "  nbr%% = search / step; step ms of the 3D table (wall) also holds the reorders into cell order.\n");
 
-  std::printf(
-      "\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
-      a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
-  std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
-              "step ms", "nbr%", "builds", "pairs");
-  for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
-    std::string source;
-    const nlohmann::json base = read_scene_json(name, source);
-    for (Method m : methods) {
-      nlohmann::json j = base;
-      j["neighbors"]["method"] = std::string(method_name(m));
-      if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
-      if (!reorders.empty()) j["neighbors"]["reorder_every"] = reorders.front();
-      if (a.subdivision > 0) j["neighbors"]["subdivision"] = a.subdivision;
-      const StepFigures f = time_scene({j}, source, warmup, steps).front();
-      const double step = f.neighbors_ms + f.dynamics_ms;
-      std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
-                  std::string(method_name(m)).c_str(), f.neighbors_ms, f.dynamics_ms, step,
-                  100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
-                  static_cast<unsigned long long>(f.pairs));
-      std::fflush(stdout);
+  if (on_device)
+    std::printf(
+        "  backend %s: the step runs on the device (rows rebuilt every step by its sorted grid: builds =\n"
+        "  steps); Table 1 and the paper model are CPU only (docs/gpu.md).\n",
+        a.backend.c_str());
+  if (!on_device) {
+    std::printf(
+        "\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
+        a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
+    std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
+                "step ms", "nbr%", "builds", "pairs");
+    for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
+      std::string source;
+      const nlohmann::json base = read_scene_json(name, source);
+      for (Method m : methods) {
+        nlohmann::json j = base;
+        j["neighbors"]["method"] = std::string(method_name(m));
+        if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
+        if (!reorders.empty()) j["neighbors"]["reorder_every"] = reorders.front();
+        if (a.subdivision > 0) j["neighbors"]["subdivision"] = a.subdivision;
+        const StepFigures f = time_scene({j}, source, warmup, steps).front();
+        const double step = f.neighbors_ms + f.dynamics_ms;
+        std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
+                    std::string(method_name(m)).c_str(), f.neighbors_ms, f.dynamics_ms, step,
+                    100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
+                    static_cast<unsigned long long>(f.pairs));
+        std::fflush(stdout);
+      }
     }
   }
 
@@ -474,6 +486,7 @@ void run_bench_sph(const SphArgs& a) {
   for (std::size_t n : sizes) {
     const double spacing = std::cbrt(volume / static_cast<double>(n));
     for (const auto& model : models) {
+      if (on_device && model != "wcsph") continue;
       for (const auto& prec : precisions) {
         nlohmann::json j = base;
         j["spacing"] = spacing;
@@ -483,6 +496,7 @@ void run_bench_sph(const SphArgs& a) {
         if (model == "paper") j["solver"].erase("artificial_viscosity");
         j["precision"] = prec;
         j["neighbors"]["method"] = "cell-index";
+        j["solver"]["backend"] = std::string(backend_name(*backend));
         if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
         std::vector<nlohmann::json> variants;
         for (const long r : reorders) {
@@ -557,6 +571,7 @@ void register_bench(CLI::App& app, int& result) {
       "(default: the scenes')");
   sph->add_option("--methods", sargs->methods,
                   "comma-separated methods for Table 1 (default: all): " + method_names_joined(","));
+  sph->add_option("--backend", sargs->backend, "where the steps run: cpu or cuda")->capture_default_str();
   sph->add_option("--models", sargs->models, "models of the 3D runs: wcsph,paper")->capture_default_str();
   sph->add_option("--precisions", sargs->precisions, "precisions of the 3D runs: float,double")
       ->capture_default_str();

@@ -12,6 +12,7 @@
 
 #include "cellsph/neighbors/cell_index.hpp"
 #include "cellsph/render/image.hpp"
+#include "cellsph/solver/backend.hpp"
 #include "cellsph/surface/surface.hpp"
 #include "commands.hpp"
 
@@ -31,8 +32,12 @@ int doctor() {
               "debug"
 #endif
   );
-  std::printf("backends:     cpu (OpenMP); cuda not in this build (cellsph has no GPU backend yet)\n");
-  std::printf("device:       none used: this build runs on the CPU only\n");
+  if (cuda_built())
+    std::printf("backends:     cpu (OpenMP), cuda (--backend cuda; docs/gpu.md)\n");
+  else
+    std::printf(
+        "backends:     cpu (OpenMP); cuda not in this build (configure with -DCELLSPH_CUDA=ON and nvcc)\n");
+  std::printf("device:       %s\n", cuda_device_report().text.c_str());
   std::printf(
       "threads:      %d OpenMP threads by default (OMP_NUM_THREADS or --threads to change), %u "
       "hardware threads\n",

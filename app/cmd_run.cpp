@@ -68,6 +68,7 @@ struct RunOptions {
   std::string out;
   int threads = 0;
   std::string method;
+  std::string backend;  // empty: the scene's solver.backend
   double until = -1;
   long steps = -1;
   double fps = -1;
@@ -223,6 +224,10 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
                        ")");
     cfg.search.method = *m;
   }
+  if (!opt.backend.empty())
+    cfg.backend = *parse_backend(opt.backend);  // checked by run_command
+  else
+    require_backend(cfg.backend, source + ": /solver/backend");  // the scene's, before anything is written
   OutputSettings os = scene.output;
   if (opt.until > 0) os.end_time = opt.until;
   if (opt.fps > 0) os.fps = opt.fps;
@@ -443,6 +448,8 @@ int run_command(RunOptions opt) {
       source = saved.at("source").get<std::string>();
       const auto& o = saved.at("options");
       if (opt.method.empty()) opt.method = o.at("method").get<std::string>();
+      // A checkpoint does not depend on the backend: a resume may pick another one.
+      if (opt.backend.empty() && o.contains("backend")) opt.backend = o.at("backend").get<std::string>();
       if (opt.fps <= 0) opt.fps = o.at("fps").get<double>();
       if (opt.formats.empty()) opt.formats = o.at("formats").get<std::string>();
       if (opt.until <= 0) opt.until = o.at("until").get<double>();
@@ -473,6 +480,11 @@ int run_command(RunOptions opt) {
     throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() +
                      ")");
   if (!opt.formats.empty()) parse_output_formats(opt.formats, "--format");
+  if (!opt.backend.empty()) {
+    const auto b = parse_backend(opt.backend);
+    if (!b) throw InputError("--backend: unknown backend '" + opt.backend + "' (expected cpu or cuda)");
+    require_backend(*b, "--backend");  // before anything is written: no build, device or driver
+  }
   if (!opt.color_by.empty()) parse_color_by(opt.color_by, "--color-by");
 
   // Called by run_scene once everything is valid: the first writes of the run.
@@ -486,10 +498,11 @@ int run_command(RunOptions opt) {
     nlohmann::json saved;
     saved["scene"] = scene_json;
     saved["source"] = source;
-    saved["options"] = {
-        {"method", opt.method},     {"fps", opt.fps},         {"formats", opt.formats},
-        {"until", opt.until},       {"steps", opt.steps},     {"render", opt.render},
-        {"color_by", opt.color_by}, {"surface", opt.surface}, {"surface_format", opt.surface_format}};
+    saved["options"] = {{"method", opt.method},   {"backend", opt.backend},
+                        {"fps", opt.fps},         {"formats", opt.formats},
+                        {"until", opt.until},     {"steps", opt.steps},
+                        {"render", opt.render},   {"color_by", opt.color_by},
+                        {"surface", opt.surface}, {"surface_format", opt.surface_format}};
     write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
   };
 
@@ -515,6 +528,8 @@ void register_run(CLI::App& app, int& result) {
       ->check(CLI::PositiveNumber);
   sub->add_option("--method", opt->method,
                   "Neighbour search: " + method_names_joined() + " (default: the scene's, else cell-index)");
+  sub->add_option("--backend", opt->backend,
+                  "Where the steps run: cpu or cuda (default: the scene's solver.backend, else cpu)");
   sub->add_option("--until", opt->until, "Simulated end time in seconds (default: the scene's time.end)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--steps", opt->steps, "Stop after this many steps instead of at an end time")

@@ -147,6 +147,7 @@ class SimBase {
   virtual void checkpoint(const fs::path& path) const = 0;
   virtual void restore(const fs::path& path) = 0;
   [[nodiscard]] virtual py::dict timings() const = 0;
+  virtual void use_backend(Backend b) = 0;
 
   [[nodiscard]] const PyScene& scene() const { return scene_; }
   [[nodiscard]] int threads() const { return threads_; }
@@ -174,6 +175,7 @@ class SimImpl final : public SimBase {
   SimImpl(PyScene scene, int threads) : SimBase(std::move(scene), threads), sim_(make(scene_)) {}
 
   void step() override { sim_.step(); }
+  void use_backend(Backend b) override { sim_.use_backend(b); }
   [[nodiscard]] double time() const override { return double(sim_.time()); }
   [[nodiscard]] std::uint64_t steps() const override { return sim_.steps(); }
   [[nodiscard]] double last_dt() const override { return double(sim_.last_dt()); }
@@ -290,24 +292,29 @@ std::unique_ptr<SimBase> make_sim(PyScene scene, int threads) {
   return std::make_unique<SimImpl<3, double>>(std::move(scene), threads);
 }
 
-void check_backend(const std::string& backend) {
-  if (backend == "cpu") return;
-  if (backend == "cuda")
-    throw std::runtime_error(
-        "backend 'cuda': this build of cellsph has no CUDA backend (cellsph has no GPU code yet); use "
-        "backend='cpu'");
-  throw ArgumentError("backend: unknown backend '" + backend + "' (expected 'cpu')");
+// The backend named by `backend` (ValueError if unknown); RuntimeError when this build or machine cannot
+// run it (no CUDA backend in the build, or no usable device: the CUDA runtime's message).
+Backend check_backend(const std::string& backend) {
+  const auto b = parse_backend(backend);
+  if (!b) throw ArgumentError("backend: unknown backend '" + backend + "' (expected 'cpu' or 'cuda')");
+  try {
+    require_backend(*b, "backend '" + backend + "'");
+  } catch (const InputError& e) {
+    throw std::runtime_error(e.what());
+  }
+  return *b;
 }
 
 class PySimulation {
  public:
   PySimulation(const PyScene& scene, int threads, const std::string& backend) {
-    check_backend(backend);
+    const Backend b = check_backend(backend);
     sim_ = make_sim(scene, check_threads(threads));
+    if (b != Backend::Cpu) sim_->use_backend(b);
   }
 
   static PySimulation resume(const py::handle& path_obj, int threads, const std::string& backend) {
-    check_backend(backend);
+    const Backend b = check_backend(backend);
     check_threads(threads);
     const fs::path path = path_arg(path_obj, "path");
     const std::string extra = read_simulation_checkpoint_extra(path);
@@ -322,6 +329,7 @@ class PySimulation {
       PySimulation s(std::move(scene), threads);
       ScopedThreads scoped(threads);
       s.sim_->restore(path);
+      if (b != Backend::Cpu) s.sim_->use_backend(b);  // a checkpoint does not depend on the backend
       return s;
     } catch (const nlohmann::json::exception& e) {
       throw ArgumentError("checkpoint '" + path.string() + "': its scene is damaged (" + e.what() + ")");
@@ -471,8 +479,8 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
 (`kind`: 0 fluid, 1 boundary). The GIL is released while the solver steps.)doc")
       .def(py::init<const PyScene&, int, const std::string&>(), "scene"_a, "threads"_a = 0,
            "backend"_a = "cpu",
-           "threads: OpenMP threads for every call (0 = all cores). backend: 'cpu' (a build without the GPU "
-           "backend raises RuntimeError for 'cuda').")
+           "threads: OpenMP threads for every call (0 = all cores). backend: 'cpu' or 'cuda' (RuntimeError "
+           "when this build has no CUDA backend or finds no usable device; docs/gpu.md).")
       .def_static("resume", &PySimulation::resume, "A simulation from a file written by checkpoint().",
                   "path"_a, "threads"_a = 0, "backend"_a = "cpu")
       .def("step", &PySimulation::step, "Advances `count` time steps.", "count"_a = 1)

@@ -81,7 +81,7 @@ CELLSPH_HD constexpr Real distance2(const Vec<Dim, Real>& a, const Vec<Dim, Real
 }
 
 template <int Dim, class Real>
-inline bool all_finite(const Vec<Dim, Real>& a) {
+CELLSPH_HD inline bool all_finite(const Vec<Dim, Real>& a) {
   for (int k = 0; k < Dim; ++k)
     if (!std::isfinite(a.c[k])) return false;
   return true;

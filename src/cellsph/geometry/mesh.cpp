@@ -10,10 +10,12 @@
 #include <limits>
 #include <unordered_map>
 
+#ifndef CELLSPH_NO_ASSIMP  // the GPU check's build (cmake/gpu_check.cmake): no Assimp on that machine
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
+#endif
 
 #include "cellsph/core/error.hpp"
 
@@ -159,7 +161,9 @@ TriangleMesh parse_mesh(std::string_view bytes, std::string_view extension, cons
   if (bytes.empty()) fail(label, "is empty");
   if (ext == "stl") check_stl(bytes, label);
   if (ext == "ply") check_ply(bytes, label);
-
+#ifdef CELLSPH_NO_ASSIMP
+  fail(label, "cannot be read: this build of cellsph has no mesh reader (built without Assimp)");
+#else
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
   // From memory with the extension as the hint: only that format's reader runs, and an OBJ file's
@@ -231,6 +235,7 @@ TriangleMesh parse_mesh(std::string_view bytes, std::string_view extension, cons
     fail(label, "has " + std::to_string(lines_or_points) +
                     " points or lines besides its triangles (a closed surface of triangles is needed)");
   return m;
+#endif
 }
 
 void transform(TriangleMesh& m, const MeshTransform& t) {

@@ -456,6 +456,7 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   auto sr = r.child("solver");
   cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph", "dfsph"}));
   if (cfg.model == Model::Dfsph) cfg.time.courant = Real(0.4);  // on the particle diameter (models/dfsph.hpp)
+  cfg.backend = *parse_backend(sr.choice("backend", "cpu", {"cpu", "cuda", "host-device"}));
   cfg.support = static_cast<Real>(sr.number("support", 2 * spacing, 1e-9, 1e9));
   if (cfg.support < static_cast<Real>(spacing))
     sr.fail("support", "value " + std::to_string(cfg.support) + " is smaller than the particle spacing " +

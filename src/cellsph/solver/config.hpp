@@ -11,6 +11,7 @@
 #include "cellsph/neighbors/neighbor_list.hpp"
 #include "cellsph/physics/eos.hpp"
 #include "cellsph/physics/kernels.hpp"
+#include "cellsph/solver/backend.hpp"
 
 namespace cellsph {
 
@@ -115,6 +116,9 @@ struct SolverConfig {
   using V = Vec<Dim, Real>;
 
   Model model = Model::PaperMultiphase;
+  // Where the steps run (backend.hpp; scene key solver.backend, `--backend`): the Simulation moves its
+  // particles to a device at construction when this is not Cpu.
+  Backend backend = Backend::Cpu;
 
   // Kernels. Density uses `density_kernel` (the paper: poly6), pressure the gradient of `pressure_kernel`
   // (the paper: spiky); the WCSPH model also uses that gradient in the laminar (Morris) and artificial

@@ -1,7 +1,10 @@
 #pragma once
 // Struct-of-arrays particle storage. The one list of fields is for_each_field(): outputs,
-// checkpoints and reordering are generated from it, so a new field is added in two places only
-// (the member and its line in the list).
+// checkpoints, reordering and the host <-> device mirror copies (solver/device/memory_space.hpp) are
+// generated from it, so a new field is added in two places only (the member and its line in the list).
+// The storage is generic over its array type: Particles (std::vector, host memory) is what every
+// solver, reader and writer uses; DeviceParticles<Dim, Real, Space> holds the same fields in a device
+// memory space.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
@@ -18,45 +21,55 @@ namespace cellsph {
 // density), are never integrated and only interact with fluid particles.
 enum class ParticleKind : std::uint8_t { Fluid = 0, Boundary = 1 };
 
-template <int Dim, class Real>
-struct Particles {
+template <class T>
+using HostArray = std::vector<T>;
+
+template <int Dim, class Real, template <class> class Array>
+struct BasicParticles {
   using V = Vec<Dim, Real>;
 
-  std::vector<V> x;                 // position [m]
-  std::vector<V> v;                 // velocity [m/s]
-  std::vector<V> f;                 // total force of the last evaluation [N]
-  std::vector<Real> m;              // mass [kg]
-  std::vector<Real> rho;            // density [kg/m^3]
-  std::vector<Real> p;              // pressure [Pa]
-  std::vector<Real> h;              // support length [m]
-  std::vector<Real> color;          // interface colour value c_int (paper eq. 8c)
-  std::vector<Real> mu;             // dynamic viscosity [Pa s]
-  std::vector<std::int32_t> phase;  // phase index into the scene's phase table
-  std::vector<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
-  std::vector<std::int64_t> tick;   // per-particle steps: state time in units of dt_max / 2^max_level
-  std::vector<std::uint8_t> kind;   // ParticleKind: fluid (integrated) or boundary (static, Akinci 2012)
+  Array<V> x;                 // position [m]
+  Array<V> v;                 // velocity [m/s]
+  Array<V> f;                 // total force of the last evaluation [N]
+  Array<Real> m;              // mass [kg]
+  Array<Real> rho;            // density [kg/m^3]
+  Array<Real> p;              // pressure [Pa]
+  Array<Real> h;              // support length [m]
+  Array<Real> color;          // interface colour value c_int (paper eq. 8c)
+  Array<Real> mu;             // dynamic viscosity [Pa s]
+  Array<std::int32_t> phase;  // phase index into the scene's phase table
+  Array<std::int32_t> level;  // per-particle time-step level n_i (dt_i = dt_max / 2^n_i)
+  Array<std::int64_t> tick;   // per-particle steps: state time in units of dt_max / 2^max_level
+  Array<std::uint8_t> kind;   // ParticleKind: fluid (integrated) or boundary (static, Akinci 2012)
   // Persistent identity: a permutation of 0..n-1 that travels with the particle. The Simulation
   // permutes the arrays into cell order (config reorder_every), so an index names a particle only
   // between two reorders; the id names it for the whole run (outputs are written in id order).
-  std::vector<std::uint32_t> id;
+  Array<std::uint32_t> id;
 
-  // The field list. f(name, vector) for every field, in a fixed order.
+  // The field list: fn(name, the field of s0, the field of s1, ...) for every field, in a fixed order.
+  // Several storages are walked in lockstep (a host copy and its device mirror, whatever their array
+  // types), so copies between them are written once over this list.
+  template <class F, class... Selves>
+  static void for_each_field_of(F&& fn, Selves&... s) {
+    fn(std::string_view("position"), s.x...);
+    fn(std::string_view("velocity"), s.v...);
+    fn(std::string_view("force"), s.f...);
+    fn(std::string_view("mass"), s.m...);
+    fn(std::string_view("density"), s.rho...);
+    fn(std::string_view("pressure"), s.p...);
+    fn(std::string_view("support"), s.h...);
+    fn(std::string_view("color"), s.color...);
+    fn(std::string_view("viscosity"), s.mu...);
+    fn(std::string_view("phase"), s.phase...);
+    fn(std::string_view("level"), s.level...);
+    fn(std::string_view("tick"), s.tick...);
+    fn(std::string_view("kind"), s.kind...);
+    fn(std::string_view("id"), s.id...);
+  }
+  // f(name, field) for every field of `self`, in the order above.
   template <class Self, class F>
   static void for_each_field(Self& self, F&& fn) {
-    fn(std::string_view("position"), self.x);
-    fn(std::string_view("velocity"), self.v);
-    fn(std::string_view("force"), self.f);
-    fn(std::string_view("mass"), self.m);
-    fn(std::string_view("density"), self.rho);
-    fn(std::string_view("pressure"), self.p);
-    fn(std::string_view("support"), self.h);
-    fn(std::string_view("color"), self.color);
-    fn(std::string_view("viscosity"), self.mu);
-    fn(std::string_view("phase"), self.phase);
-    fn(std::string_view("level"), self.level);
-    fn(std::string_view("tick"), self.tick);
-    fn(std::string_view("kind"), self.kind);
-    fn(std::string_view("id"), self.id);
+    for_each_field_of(fn, self);
   }
   template <class F>
   void for_each_field(F&& fn) {
@@ -72,6 +85,10 @@ struct Particles {
     for_each_field([n](std::string_view, auto& field) { field.resize(n); });
   }
 };
+
+// The host storage every solver, reader and writer uses.
+template <int Dim, class Real>
+using Particles = BasicParticles<Dim, Real, HostArray>;
 
 // True when particle k has id k for every k (the order the outputs are written in).
 template <int Dim, class Real>

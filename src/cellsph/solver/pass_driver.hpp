@@ -4,7 +4,9 @@
 // the split (and with it every result) depends only on the thread count. Every pass writes only
 // particle i's own entries (or reduces), so the order in which the indices run does not matter.
 //
-// A GPU backend replaces these functions by kernel launches over the same passes.
+// The device backends (solver/device/) overload run_pass, reduce_max and first_where for their index
+// sets (DeviceIndexSet<Space>): the model files call them unchanged, and with a CUDA index set they are
+// kernel launches over the same passes (cuda/cuda_driver.cuh).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -30,14 +32,14 @@ void run_pass(std::size_t n, const Pass& pass) {
   parallel_for(n, [&](std::size_t i) { pass(i); });
 }
 
-// The largest pass(i) over `set`, each value a Result with members combined by Result::max_of (a
-// maximum does not depend on the order of evaluation, so the reduction is deterministic). Starts from
-// `init`.
+// The largest pass(idx[k]) over k in [0, count), each value a Result with members combined by
+// Result::max_of (a maximum does not depend on the order of evaluation, so the reduction is
+// deterministic). Starts from `init`. The index array is host memory (the CPU, or the host-emulated
+// device of solver/device/).
 template <class Result, class Pass>
-Result reduce_max(const IndexSet& set, Result init, const Pass& pass) {
+Result reduce_max_n(const std::uint32_t* idx, std::size_t n, Result init, const Pass& pass) {
   std::vector<Result> partial(static_cast<std::size_t>(max_threads()), init);
-  const auto count = static_cast<std::int64_t>(set.size());
-  const std::uint32_t* idx = set.data();
+  const auto count = static_cast<std::int64_t>(n);
 #pragma omp parallel
   {
     Result r = init;
@@ -72,18 +74,29 @@ double reduce_sum(const IndexSet& set, const Pass& pass) {
   return s;
 }
 
-// The lowest index i of `set` with pred(i) true, or -1 if none (deterministic: a minimum).
+// The lowest index idx[k] with pred(idx[k]) true, or -1 if none (deterministic: a minimum).
 template <class Pred>
-std::int64_t first_where(const IndexSet& set, const Pred& pred) {
+std::int64_t first_where_n(const std::uint32_t* idx, std::size_t n, const Pred& pred) {
   std::int64_t first = std::numeric_limits<std::int64_t>::max();
-  const auto count = static_cast<std::int64_t>(set.size());
-  const std::uint32_t* idx = set.data();
+  const auto count = static_cast<std::int64_t>(n);
 #pragma omp parallel for schedule(static) reduction(min : first)
   for (std::int64_t k = 0; k < count; ++k) {
     const std::uint32_t i = idx[k];
     if (pred(static_cast<std::size_t>(i))) first = std::min(first, static_cast<std::int64_t>(i));
   }
   return first == std::numeric_limits<std::int64_t>::max() ? -1 : first;
+}
+
+// The largest pass(i) over `set` (reduce_max_n).
+template <class Result, class Pass>
+Result reduce_max(const IndexSet& set, Result init, const Pass& pass) {
+  return reduce_max_n(set.data(), set.size(), init, pass);
+}
+
+// The lowest index i of `set` with pred(i) true, or -1 if none.
+template <class Pred>
+std::int64_t first_where(const IndexSet& set, const Pred& pred) {
+  return first_where_n(set.data(), set.size(), pred);
 }
 
 }  // namespace cellsph

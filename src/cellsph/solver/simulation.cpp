@@ -177,6 +177,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   if (cfg_.reorder_every > 0) reorder_slots(boundary_);
   init_boundary_weights();
   lists_valid_ = false;
+  if (cfg_.backend != Backend::Cpu) use_backend(cfg_.backend);
 }
 
 template <int Dim, class Real>
@@ -405,22 +406,18 @@ void Simulation<Dim, Real>::apply_walls() {
 // stops the run with a diagnosis.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::check_state() {
-  V lo{}, hi{};
-  bool escape = false;
-  if (cfg_.domain_set) {
-    lo = cfg_.domain_lo;
-    hi = cfg_.domain_hi;
-    escape = true;
-  } else if (cfg_.box.enabled) {
-    lo = cfg_.box.lo;
-    hi = cfg_.box.hi;
-    escape = true;
-  }
-  const Real margin = cfg_.support;
-  const std::int64_t first =
-      first_where(fluid_, StabilityCheckPass<Dim, Real>{view(), escape, lo, hi, margin});
-  if (first < 0) return;
+  const auto check = stability_check(cfg_, view());
+  const std::int64_t first = first_where(fluid_, check);
+  if (first >= 0) report_unstable(first);
+}
 
+// The SimulationError of check_state for fluid particle `first` (the lowest failing index).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
+  sync_host();
+  const auto check = stability_check(cfg_, ParticleView<Dim, Real>{});
+  const V lo = check.lo, hi = check.hi;
+  const Real margin = check.margin;
   const auto i = static_cast<std::size_t>(first);
   std::ostringstream os;
   os.precision(9);
@@ -505,6 +502,10 @@ void Simulation<Dim, Real>::step_per_particle() {
 
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step() {
+  if (device_) {
+    step_device();
+    return;
+  }
   if (cfg_.time.mode == TimeStepping::PerParticle) {
     step_per_particle();
     return;
@@ -579,6 +580,7 @@ void Simulation<Dim, Real>::run_until(Real t_end) {
 
 template <int Dim, class Real>
 auto Simulation<Dim, Real>::momentum() const -> V {
+  sync_host();
   V s{};
   for (std::size_t i = 0; i < p_.size(); ++i)
     if (p_.kind[i] == kFluid) s += p_.v[i] * p_.m[i];
@@ -587,6 +589,7 @@ auto Simulation<Dim, Real>::momentum() const -> V {
 
 template <int Dim, class Real>
 Real Simulation<Dim, Real>::kinetic_energy() const {
+  sync_host();
   Real s = 0;
   for (std::size_t i = 0; i < p_.size(); ++i)
     if (p_.kind[i] == kFluid) s += p_.m[i] * norm2(p_.v[i]) / 2;
@@ -595,6 +598,7 @@ Real Simulation<Dim, Real>::kinetic_energy() const {
 
 template <int Dim, class Real>
 Real Simulation<Dim, Real>::total_mass() const {
+  sync_host();
   Real s = 0;
   for (std::size_t i = 0; i < p_.size(); ++i)
     if (p_.kind[i] == kFluid) s += p_.m[i];
@@ -697,6 +701,54 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   last_dt_ = state.last_dt;
   steps_ = state.steps;
   leapfrog_started_ = state.leapfrog_started;
+  if (device_) {
+    device_->upload(p_);
+    host_stale_ = false;
+  }
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::use_backend(Backend b) {
+  if (b == backend_) return;
+  if (b == Backend::Cpu) {
+    sync_host();
+    device_.reset();
+    backend_ = b;
+    lists_valid_ = false;
+    return;
+  }
+  require_backend(b, "solver.backend");
+  if (const std::string why = device_step_unsupported(cfg_); !why.empty())
+    throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
+  sync_host();
+  device_ = b == Backend::Cuda ? make_cuda_stepper(cfg_) : make_host_device_stepper(cfg_);
+  device_->upload(p_);
+  backend_ = b;
+}
+
+// One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH
+// with global steps, on the device's copy of the particles.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::step_device() {
+  const DeviceStepResult<Real> r = device_->step();
+  host_stale_ = true;
+  timings_.neighbors += r.neighbors_ms;
+  timings_.forces += r.forces_ms;
+  timings_.integration += r.integration_ms;
+  ++timings_.list_builds;
+  timings_.density_evals += fluid_count_;
+  timings_.force_evals += fluid_count_;
+  if (r.first_bad >= 0) report_unstable(r.first_bad);  // copies the particles back to describe it
+  time_ += r.dt;
+  last_dt_ = r.dt;
+  ++steps_;
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::sync_host() const {
+  if (!host_stale_) return;
+  device_->download(p_);
+  host_stale_ = false;
 }
 
 template class Simulation<2, float>;

@@ -23,15 +23,18 @@
 // positions and ids, so results stay independent of the method, the skin and the thread count, and a
 // checkpoint (which holds the permuted order and the ids) resumes bit for bit.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cellsph/core/timer.hpp"
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
+#include "cellsph/solver/backend.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
+#include "cellsph/solver/device/device_stepper_base.hpp"
 #include "cellsph/solver/particle_view.hpp"
 #include "cellsph/solver/particles.hpp"
 #include "cellsph/solver/pass_driver.hpp"
@@ -89,7 +92,12 @@ class Simulation {
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   [[nodiscard]] Real last_dt() const { return last_dt_; }
   // In the internal (cell) order: see "Particle order" above; particles().id names each particle.
-  [[nodiscard]] const Particles<Dim, Real>& particles() const { return p_; }
+  // With a device backend the particles are copied back here, only when the device holds newer ones
+  // (at output and checkpoint times).
+  [[nodiscard]] const Particles<Dim, Real>& particles() const {
+    sync_host();
+    return p_;
+  }
   [[nodiscard]] const Config& config() const { return cfg_; }
   [[nodiscard]] const StepTimings& timings() const { return timings_; }
   [[nodiscard]] const SearchStats& search_stats() const { return search_.stats(); }
@@ -123,6 +131,15 @@ class Simulation {
   // of their last evaluation); only the cost changes.
   void set_full_passes(bool on) { full_passes_ = on; }
 
+  // The backend of the following steps (backend.hpp). Cpu (the default) steps here; Cuda and HostDevice
+  // copy the particles to the device, which from then on holds the state between steps
+  // (solver/device/). Throws InputError when the backend is not available (require_backend) or does not
+  // support this config (the device step: WCSPH with global steps, Akinci or Adami walls, no reorder).
+  // Switching back to Cpu copies the particles back. Results: bit-identical to the CPU through
+  // HostDevice; within rounding on a GPU (docs/gpu.md).
+  void use_backend(Backend b);
+  [[nodiscard]] Backend backend() const { return backend_; }
+
  private:
   // The plain view of every per-particle array the passes read (particle_view.hpp). Built afresh for each
   // pass: it holds the arrays' current addresses, which change when an array is resized or swapped.
@@ -149,6 +166,9 @@ class Simulation {
   void integrate_wcsph(Real dt);
   void apply_walls();
   void check_state();
+  [[noreturn]] void report_unstable(std::int64_t first) const;
+  void step_device();
+  void sync_host() const;
   void init_boundary_weights();
   void step_per_particle();
   void step_dfsph(Stopwatch& sw);
@@ -157,7 +177,11 @@ class Simulation {
   void reorder_slots(const IndexList& slots);
 
   Config cfg_;
-  Particles<Dim, Real> p_;
+  // Mutable: with a device backend, particles() (const) copies the device's newer state back here.
+  mutable Particles<Dim, Real> p_;
+  Backend backend_ = Backend::Cpu;
+  std::unique_ptr<DeviceStepperBase<Dim, Real>> device_;  // null on the CPU
+  mutable bool host_stale_ = false;                       // the device holds newer particles than p_
   NeighborSearch<Dim, Real> search_;
   NeighborList nl_;
   std::vector<std::uint32_t> within_;  // filter_lists: row i at nl_.offsets[i], within_count_[i] long

@@ -6,6 +6,7 @@
 #include <cstddef>
 
 #include "cellsph/core/hd.hpp"
+#include "cellsph/solver/config.hpp"
 #include "cellsph/solver/particle_view.hpp"
 
 namespace cellsph {
@@ -26,5 +27,23 @@ struct StabilityCheckPass {
     return false;
   }
 };
+
+// The check's domain: the scene's domain if set, else the box if enabled, else none (escape false);
+// margin one support.
+template <int Dim, class Real>
+StabilityCheckPass<Dim, Real> stability_check(const SolverConfig<Dim, Real>& cfg,
+                                              const ParticleView<Dim, Real>& pv) {
+  StabilityCheckPass<Dim, Real> c{pv, false, {}, {}, cfg.support};
+  if (cfg.domain_set) {
+    c.lo = cfg.domain_lo;
+    c.hi = cfg.domain_hi;
+    c.escape = true;
+  } else if (cfg.box.enabled) {
+    c.lo = cfg.box.lo;
+    c.hi = cfg.box.hi;
+    c.escape = true;
+  }
+  return c;
+}
 
 }  // namespace cellsph

@@ -53,9 +53,9 @@ struct Adami2012WallStatePass {
 };
 
 // The states of the wall particles of `boundary`, after the density pass and gather_wall_neighbors.
-template <int Dim, class Real>
+template <int Dim, class Real, class Set>
 void adami2012_wall_states(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                           const IndexSet& boundary) {
+                           const Set& boundary) {
   with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
     using K = std::remove_cvref_t<decltype(w)>;
     run_pass(boundary, Adami2012WallStatePass<Dim, Real, K>{pv, w, cfg.eos, cfg.gravity});

@@ -55,10 +55,11 @@ struct SummationDensityPass {
   }
 };
 
-// Densities and pressures of `set` (pv.vol and pv.prho2 sized for every particle).
-template <int Dim, class Real>
+// Densities and pressures of `set` (pv.vol and pv.prho2 sized for every particle). Set: an IndexSet, or
+// a device backend's index set (pass_driver.hpp).
+template <int Dim, class Real, class Set>
 void summation_density(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                       const IndexSet& set) {
+                       const Set& set) {
   const bool number = cfg.density == DensityFormulation::Number && cfg.model == Model::PaperMultiphase;
   with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
     using K = std::remove_cvref_t<decltype(w)>;

@@ -138,8 +138,8 @@ struct WcsphDriftPass {
 };
 
 // The forces of `set` (the fluid), after the densities and the wall states.
-template <int Dim, class Real>
-void wcsph_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& set,
+template <int Dim, class Real, class Set>
+void wcsph_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set,
                   bool any_tension, bool wall_states) {
   const Poly6Kernel<Dim, Real> wc(cfg.support);
   const Real h = smoothing_length(cfg);

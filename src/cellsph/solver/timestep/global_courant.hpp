@@ -36,9 +36,9 @@ struct CourantLimitsPass {
 };
 
 // The step of a global-step scheme over the particles of `set` (the fluid).
-template <int Dim, class Real>
+template <int Dim, class Real, class Set>
 Real global_courant_dt(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                       const IndexSet& set) {
+                       const Set& set) {
   if (cfg.time.mode == TimeStepping::Fixed) return cfg.time.dt;
   const Real h = cfg.support;
   const Real alpha = cfg.time.courant;

@@ -1,0 +1,270 @@
+#pragma once
+// The device step (DeviceStepperBase, device_stepper_base.hpp) written once over a memory space: the
+// host-emulated device instantiates it with plain g++ (host_device_stepper.cpp), the CUDA backend with
+// nvcc (cuda/cuda_steppers_*.cu) after including cuda/cuda_driver.cuh, whose run_pass / reduce_max /
+// first_where overloads make every pass below a kernel launch. The passes are the CPU's own (models/,
+// boundary/, timestep/, integration/, stability_check.hpp); only the neighbour search differs
+// (device_grid.hpp: exact rows, rebuilt every step, no Verlet skin), and it gives the CPU's rows.
+//
+// The state stays in the space between steps: every field of the particles (DeviceParticles, copied over
+// the field list), the solver's per-particle arrays, the rows. One value per step comes back to the host
+// (the reduction for dt), plus the stability check's first failing index and the row totals.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/core/timer.hpp"
+#include "cellsph/solver/boundary/adami2012.hpp"
+#include "cellsph/solver/config.hpp"
+#include "cellsph/solver/device/device_driver.hpp"
+#include "cellsph/solver/device/device_grid.hpp"
+#include "cellsph/solver/device/device_stepper_base.hpp"
+#include "cellsph/solver/device/memory_space.hpp"
+#include "cellsph/solver/integration/collisions.hpp"
+#include "cellsph/solver/models/summation_density.hpp"
+#include "cellsph/solver/models/wcsph.hpp"
+#include "cellsph/solver/particle_view.hpp"
+#include "cellsph/solver/stability_check.hpp"
+#include "cellsph/solver/timestep/global_courant.hpp"
+
+namespace cellsph {
+
+template <int Dim, class Real, class Space>
+class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
+ public:
+  using V = Vec<Dim, Real>;
+  template <class T>
+  using Array = DeviceArray<T, Space>;
+  using Ops = DeviceOps<Space>;
+
+  explicit DeviceStepper(const SolverConfig<Dim, Real>& cfg) : cfg_(cfg) {
+    const std::string why = device_step_unsupported(cfg_);
+    CELLSPH_CHECK(why.empty(), why);
+    std::vector<PhaseParams<Real>> params;
+    for (const auto& ph : cfg_.phases) {
+      params.push_back({ph.rest_density, ph.viscosity, ph.sigma});
+      any_tension_ = any_tension_ || ph.sigma > 0;
+    }
+    phases_.upload(params.data(), params.size());
+    planes_.upload(cfg_.planes.data(), cfg_.planes.size());
+  }
+
+  void upload(const Particles<Dim, Real>& p) override {
+    upload_particles(p, d_);
+    n_ = p.size();
+    // What the Simulation derives from the fields (kinds keep their slots; rest density from the phase).
+    std::vector<std::uint32_t> fluid, boundary;
+    std::vector<Real> rho0(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      (p.kind[i] == ParticleView<Dim, Real>::kFluid ? fluid : boundary)
+          .push_back(static_cast<std::uint32_t>(i));
+      rho0[i] = cfg_.phases[static_cast<std::size_t>(p.phase[i])].rest_density;
+    }
+    fluid_.upload(fluid.data(), fluid.size());
+    boundary_.upload(boundary.data(), boundary.size());
+    rho0_.upload(rho0.data(), n_);
+    wall_states_ = cfg_.wall_model != WallModel::Akinci && !boundary.empty();
+    for (auto* a : {&vol_, &prho2_}) {
+      a->resize(n_);
+      a->zero();
+    }
+    for (auto* a : {&f_pressure_, &wall_v_}) {
+      a->resize(n_);
+      a->zero();
+    }
+  }
+
+  void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
+
+  DeviceStepResult<Real> step() override {
+    DeviceStepResult<Real> r;
+    Stopwatch sw;
+    build_rows();
+    Ops::synchronize();
+    r.neighbors_ms = sw.ms();
+
+    sw.reset();
+    const auto pv = view();
+    const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
+    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
+    summation_density(cfg_, pv, fluid);
+    if (wall_states_) adami2012_wall_states(cfg_, pv, boundary);
+    wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
+    Ops::synchronize();
+    r.forces_ms = sw.ms();
+
+    sw.reset();
+    r.dt = global_courant_dt(cfg_, pv, fluid);
+    run_pass(fluid, WcsphSymplecticEulerPass<Dim, Real>{pv, r.dt});
+    if (cfg_.box.enabled || !cfg_.planes.empty()) {
+      auto walls = box_plane_collisions(cfg_, pv);
+      walls.planes = planes_.data();  // the device's copy of cfg.planes
+      run_pass(fluid, walls);
+    }
+    r.first_bad = first_where(fluid, stability_check(cfg_, pv));
+    Ops::synchronize();
+    r.integration_ms = sw.ms();
+    return r;
+  }
+
+  DeviceRows neighbor_rows() override {
+    build_rows();
+    DeviceRows h;
+    auto get = [](const auto& dev, auto& host) {
+      host.resize(dev.size());
+      dev.download(host.data());
+    };
+    get(offsets_, h.offsets);
+    get(count_, h.count);
+    get(rows_, h.rows);
+    if (wall_states_) {
+      get(wall_start_, h.wall_start);
+      get(wall_rows_, h.wall_rows);
+    }
+    return h;
+  }
+
+ private:
+  ParticleView<Dim, Real> view() {
+    ParticleView<Dim, Real> v;
+    v.n = n_;
+    v.x = d_.x.data();
+    v.v = d_.v.data();
+    v.f = d_.f.data();
+    v.m = d_.m.data();
+    v.rho = d_.rho.data();
+    v.p = d_.p.data();
+    v.h = d_.h.data();
+    v.color = d_.color.data();
+    v.mu = d_.mu.data();
+    v.phase = d_.phase.data();
+    v.level = d_.level.data();
+    v.tick = d_.tick.data();
+    v.kind = d_.kind.data();
+    v.id = d_.id.data();
+    v.rho0 = rho0_.data();
+    v.vol = vol_.data();
+    v.prho2 = prho2_.data();
+    v.f_pressure = f_pressure_.data();
+    v.wall_v = wall_v_.data();
+    v.offsets = offsets_.data();
+    v.candidates = rows_.data();
+    v.within = rows_.data();
+    v.within_count = count_.data();
+    v.wall_start = wall_start_.data();
+    v.wall_nbr = wall_rows_.data();
+    v.phases = phases_.data();
+    return v;
+  }
+
+  // The sorted grid (device_grid.hpp) and the rows of the fluid (and, for wall states, of the walls).
+  void build_rows() {
+    const DeviceRange<Space> all{n_};
+    // Bounding box (a maximum: deterministic), then the grid over it.
+    if (identity_.size() != n_) {
+      std::vector<std::uint32_t> id(n_);
+      for (std::size_t i = 0; i < n_; ++i) id[i] = static_cast<std::uint32_t>(i);
+      identity_.upload(id.data(), n_);
+    }
+    const auto b = reduce_max(DeviceIndexSet<Space>{identity_.data(), n_}, BoundsMax<Dim, Real>{},
+                              BoundsPass<Dim, Real>{d_.x.data()});
+    GridGeometry<Dim, Real> g;
+    g.inv_cell = Real(1) / cfg_.support;
+    double cells = 1;
+    for (int a = 0; a < Dim; ++a) {
+      g.lo[a] = -b.neg_lo[a];
+      const double extent = double(b.hi[a]) - double(g.lo[a]);
+      const double d = std::floor(extent * double(g.inv_cell)) + 1;
+      cells *= d;
+      if (!(cells <= double(kMaxCells)))
+        throw SimulationError("the particles spread over more than " + std::to_string(kMaxCells) +
+                              " cells of size h (the device grid's table); a domain bounds them");
+      g.dims[a] = static_cast<std::uint32_t>(d);
+    }
+    const auto ncells = static_cast<std::size_t>(cells);
+    int bits = 1;
+    while (bits < 32 && (std::size_t{1} << bits) < ncells) ++bits;
+
+    for (auto* a : {&key_, &idx_, &sorted_key_, &sorted_idx_}) a->resize(n_);
+    xs_.resize(n_);
+    run_pass(all, CellKeyPass<Dim, Real>{g, d_.x.data(), key_.data(), idx_.data()});
+    Ops::sort_pairs(key_.data(), idx_.data(), sorted_key_.data(), sorted_idx_.data(), n_, bits, scratch_);
+    run_pass(all, GatherPositionsPass<Dim, Real>{d_.x.data(), sorted_idx_.data(), xs_.data()});
+    cell_start_.resize(ncells);
+    cell_end_.resize(ncells);
+    run_pass(DeviceRange<Space>{ncells}, ClearCellsPass{cell_start_.data()});
+    run_pass(all, CellBoundsPass{sorted_key_.data(), n_, cell_start_.data(), cell_end_.data()});
+
+    // Fluid rows: count, scan into offsets, fill (and sort).
+    count_.resize(n_ + 1);
+    count_.zero();
+    offsets_.resize(n_ + 1);
+    const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
+    GridRowPass<Dim, Real, std::uint64_t> rp{g,
+                                             d_.x.data(),
+                                             d_.h.data(),
+                                             d_.kind.data(),
+                                             xs_.data(),
+                                             sorted_idx_.data(),
+                                             cell_start_.data(),
+                                             cell_end_.data(),
+                                             false,
+                                             count_.data(),
+                                             nullptr,
+                                             nullptr};
+    run_pass(fluid, rp);
+    Ops::exclusive_scan(count_.data(), offsets_.data(), n_, scratch_);
+    rows_.resize(static_cast<std::size_t>(offsets_.get(n_)));
+    rp.offsets = offsets_.data();
+    rp.rows = rows_.data();
+    run_pass(fluid, rp);
+
+    if (!wall_states_) return;
+    // Wall rows: the fluid neighbours of each wall particle.
+    wall_count_.resize(n_ + 1);
+    wall_count_.zero();
+    wall_start_.resize(n_ + 1);
+    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
+    GridRowPass<Dim, Real, std::uint32_t> wp{g,
+                                             d_.x.data(),
+                                             d_.h.data(),
+                                             d_.kind.data(),
+                                             xs_.data(),
+                                             sorted_idx_.data(),
+                                             cell_start_.data(),
+                                             cell_end_.data(),
+                                             true,
+                                             wall_count_.data(),
+                                             nullptr,
+                                             nullptr};
+    run_pass(boundary, wp);
+    Ops::exclusive_scan(wall_count_.data(), wall_start_.data(), n_, scratch_);
+    wall_rows_.resize(wall_start_.get(n_));
+    wp.offsets = wall_start_.data();
+    wp.rows = wall_rows_.data();
+    run_pass(boundary, wp);
+  }
+
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 30;
+
+  SolverConfig<Dim, Real> cfg_;
+  std::size_t n_ = 0;
+  bool any_tension_ = false;
+  bool wall_states_ = false;
+  DeviceParticles<Dim, Real, Space> d_;
+  Array<PhaseParams<Real>> phases_;
+  Array<Plane<Dim, Real>> planes_;
+  Array<std::uint32_t> fluid_, boundary_, identity_;
+  Array<Real> rho0_, vol_, prho2_;
+  Array<V> f_pressure_, wall_v_;
+  // The grid and the rows.
+  Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;
+  Array<V> xs_;
+  Array<std::uint32_t> count_, rows_, wall_count_, wall_start_, wall_rows_;
+  Array<std::uint64_t> offsets_;
+  typename Ops::Bytes scratch_;
+};
+
+}  // namespace cellsph

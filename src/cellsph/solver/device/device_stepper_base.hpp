@@ -1,0 +1,90 @@
+#pragma once
+// What Simulation (simulation.hpp) sees of a device backend: the particles copied to the device once,
+// steps run there (the state stays on the device between steps), and copies back only when asked (at
+// output and checkpoint times). No CUDA type appears here: the CUDA implementation is in cuda/*.cu, the
+// host-emulated one ("host device", for tests without a GPU) in host_device_stepper.cpp; both are the
+// one template DeviceStepper (device_stepper.hpp) over a memory space.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cellsph/solver/config.hpp"
+#include "cellsph/solver/particles.hpp"
+
+namespace cellsph {
+
+template <class Real>
+struct DeviceStepResult {
+  Real dt = 0;                  // the step taken
+  std::int64_t first_bad = -1;  // the lowest fluid index failing the stability check, or -1
+  double neighbors_ms = 0;      // wall time of the phases (the device synchronised between them)
+  double forces_ms = 0;
+  double integration_ms = 0;
+};
+
+// The device's neighbour rows copied to the host (tests, scripts/gpu_check.sh). Row i of a fluid particle
+// is rows[offsets[i] .. offsets[i] + count[i]); wall row b is wall_rows[wall_start[b] .. wall_start[b + 1])
+// (empty without wall states).
+struct DeviceRows {
+  std::vector<std::uint64_t> offsets;
+  std::vector<std::uint32_t> count, rows, wall_start, wall_rows;
+};
+
+template <int Dim, class Real>
+class DeviceStepperBase {
+ public:
+  DeviceStepperBase() = default;
+  DeviceStepperBase(const DeviceStepperBase&) = delete;
+  DeviceStepperBase& operator=(const DeviceStepperBase&) = delete;
+  virtual ~DeviceStepperBase() = default;
+  // Every field of the field list (particles.hpp) to the device (the index sets and rest densities are
+  // derived from them there).
+  virtual void upload(const Particles<Dim, Real>& p) = 0;
+  // Every field back into p (resized).
+  virtual void download(Particles<Dim, Real>& p) = 0;
+  // One step of Simulation::step() for WCSPH with a global step: neighbour rows, density, wall states,
+  // forces, dt, symplectic Euler, box and planes, the stability check. Positions are left as computed
+  // even when the check fails (as on the CPU).
+  virtual DeviceStepResult<Real> step() = 0;
+  // The rows of the current positions (built afresh), copied to the host.
+  virtual DeviceRows neighbor_rows() = 0;
+};
+
+// Empty when the device step runs this config; otherwise what it lacks, in one phrase.
+template <int Dim, class Real>
+std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
+  if (cfg.model != Model::Wcsph) return "only the WCSPH model runs on a device (solver.model = wcsph)";
+  if (cfg.time.mode == TimeStepping::PerParticle)
+    return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
+  if (cfg.wall_model == WallModel::Dynamic)
+    return "dynamic walls do not run on a device (boundary.model = akinci or adami)";
+  if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
+  if (cfg.density_evolution == DensityEvolution::Continuity)
+    return "the continuity density does not run on a device yet (solver.density = summation)";
+  return {};
+}
+
+// The CUDA backend (cuda/*.cu; a build without CUDA throws InputError).
+template <int Dim, class Real>
+std::unique_ptr<DeviceStepperBase<Dim, Real>> make_cuda_stepper(const SolverConfig<Dim, Real>& cfg);
+// The host-emulated device (host memory through the device API): the CUDA backend's bookkeeping on the CPU.
+template <int Dim, class Real>
+std::unique_ptr<DeviceStepperBase<Dim, Real>> make_host_device_stepper(const SolverConfig<Dim, Real>& cfg);
+
+extern template std::unique_ptr<DeviceStepperBase<2, float>> make_cuda_stepper(const SolverConfig<2, float>&);
+extern template std::unique_ptr<DeviceStepperBase<2, double>> make_cuda_stepper(
+    const SolverConfig<2, double>&);
+extern template std::unique_ptr<DeviceStepperBase<3, float>> make_cuda_stepper(const SolverConfig<3, float>&);
+extern template std::unique_ptr<DeviceStepperBase<3, double>> make_cuda_stepper(
+    const SolverConfig<3, double>&);
+extern template std::unique_ptr<DeviceStepperBase<2, float>> make_host_device_stepper(
+    const SolverConfig<2, float>&);
+extern template std::unique_ptr<DeviceStepperBase<2, double>> make_host_device_stepper(
+    const SolverConfig<2, double>&);
+extern template std::unique_ptr<DeviceStepperBase<3, float>> make_host_device_stepper(
+    const SolverConfig<3, float>&);
+extern template std::unique_ptr<DeviceStepperBase<3, double>> make_host_device_stepper(
+    const SolverConfig<3, double>&);
+
+}  // namespace cellsph
