@@ -313,10 +313,10 @@ TEST_P(WallModels, HydrostaticTankSettlesToRhoGH) {
 // (SimulationError), every particle inside the box, and the energy (kinetic + gravitational + the EOS's
 // internal energy) never above its value after the first step by more than half of m g H. Measured: Akinci
 // walls leave the domain at step 2267 (t = 1.09 s; step 2835 with the former Monaghan-form viscous operator).
-// Adami walls held with the Monaghan form (excess 0.23 m g H at 10^4 steps, still sloshing), but with Morris's
-// laminar operator (issue 14), which damps the compressive part of the flow less, they blow up too: step
-// 6366 (t = 3.05 s, energy 392 J -> 3957 J). So with Adami or Akinci walls the blow-up is asserted as the
-// open problem; the built-in WCSPH scenes add an artificial viscosity (alpha 0.01), which this box lacks.
+// Adami walls held with the Monaghan form (excess 0.23 m g H at 10^4 steps, still sloshing), but with
+// Morris's laminar operator (issue 14), which damps the compressive part of the flow less, they blow up too:
+// step 6366 (t = 3.05 s, energy 392 J -> 3957 J). So with Adami or Akinci walls the blow-up is asserted as
+// the open problem; the built-in WCSPH scenes add an artificial viscosity (alpha 0.01), which this box lacks.
 // The paper model (eq. 8a/8b, same box and EOS) blows up with either wall model: Akinci walls at t = 1.15 s,
 // Adami walls at step 7671 (t = 3.67 s, a particle through the floor); asserted as the open problem it is.
 // The cause (docs/physics.md, "Scene stability", by energy bookkeeping): the wall's own pressure term,
@@ -386,9 +386,8 @@ TEST_P(WallModels, WeaklyViscousBoxHoldsTenThousandSteps) {
     }
     // The open problem, where it remains (Akinci and Adami walls, both models): fails if it goes away, so
     // that the docs get updated.
-    EXPECT_TRUE(blew_up || e_max - e0 > tol)
-        << model_name(model) << ", walls " << wall_model_name(GetParam())
-        << " no longer blow up: update docs/physics.md";
+    EXPECT_TRUE(blew_up || e_max - e0 > tol) << model_name(model) << ", walls " << wall_model_name(GetParam())
+                                             << " no longer blow up: update docs/physics.md";
   }
 }
 

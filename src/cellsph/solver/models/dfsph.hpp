@@ -8,7 +8,8 @@
 //     diameter (V^(1/Dim)), or time.dt when the stepping is fixed;
 //  3. the divergence-free solve: Jacobi sweeps on k_i = p_i / rho_i^2 until the average of
 //     max(D rho_i / Dt, 0) dt / rho0 is at most max_divergence_error (percent);
-//  4. the non-pressure forces (gravity, the laminar viscosity of Morris et al. 1997, physics/interactions.hpp) and v* = v + dt f/m;
+//  4. the non-pressure forces (gravity, the laminar viscosity of Morris et al. 1997,
+//  physics/interactions.hpp) and v* = v + dt f/m;
 //  5. the constant-density solve: Jacobi sweeps until the average of max(rho*_i - rho0, 0) / rho0, with
 //     rho*_i = rho_i + dt D rho_i / Dt, is at most max_density_error (percent);
 //  6. x += dt v, p_i = k_i rho_i^2 (the density solve's pressure, also its next warm start).
@@ -302,7 +303,8 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     st.ms_divergence += sw.ms();
     sw.reset();
 
-    run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2), cfg.no_slip});
+    run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2),
+                                                       cfg.no_slip});
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
     st.ms_nonpressure += sw.ms();
     sw.reset();
