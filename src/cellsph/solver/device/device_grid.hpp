@@ -28,8 +28,9 @@ inline constexpr std::uint32_t kEmptyCell = 0xffffffffu;
 
 template <int Dim, class Real>
 struct BoundsMax {
-  Vec<Dim, Real> hi = Vec<Dim, Real>::filled(-HUGE_VALF);
-  Vec<Dim, Real> neg_lo = Vec<Dim, Real>::filled(-HUGE_VALF);  // max of -x: the minimum, negated
+  Vec<Dim, Real> hi = Vec<Dim, Real>::filled(static_cast<Real>(-HUGE_VALF));
+  Vec<Dim, Real> neg_lo =
+      Vec<Dim, Real>::filled(static_cast<Real>(-HUGE_VALF));  // max of -x: the minimum, negated
   CELLSPH_HD static BoundsMax max_of(const BoundsMax& a, const BoundsMax& b) {
     BoundsMax r;
     for (int k = 0; k < Dim; ++k) {
