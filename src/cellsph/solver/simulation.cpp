@@ -184,20 +184,7 @@ template <int Dim, class Real>
 ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   ParticleView<Dim, Real> v;
   v.n = p_.size();
-  v.x = p_.x.data();
-  v.v = p_.v.data();
-  v.f = p_.f.data();
-  v.m = p_.m.data();
-  v.rho = p_.rho.data();
-  v.p = p_.p.data();
-  v.h = p_.h.data();
-  v.color = p_.color.data();
-  v.mu = p_.mu.data();
-  v.phase = p_.phase.data();
-  v.level = p_.level.data();
-  v.tick = p_.tick.data();
-  v.kind = p_.kind.data();
-  v.id = p_.id.data();
+  attach_particle_fields(v, p_);
   v.rho0 = rho0_.data();
   v.vol = vol_.data();
   v.prho2 = prho2_.data();

@@ -130,20 +130,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   ParticleView<Dim, Real> view() {
     ParticleView<Dim, Real> v;
     v.n = n_;
-    v.x = d_.x.data();
-    v.v = d_.v.data();
-    v.f = d_.f.data();
-    v.m = d_.m.data();
-    v.rho = d_.rho.data();
-    v.p = d_.p.data();
-    v.h = d_.h.data();
-    v.color = d_.color.data();
-    v.mu = d_.mu.data();
-    v.phase = d_.phase.data();
-    v.level = d_.level.data();
-    v.tick = d_.tick.data();
-    v.kind = d_.kind.data();
-    v.id = d_.id.data();
+    attach_particle_fields(v, d_);
     v.rho0 = rho0_.data();
     v.vol = vol_.data();
     v.prho2 = prho2_.data();
@@ -197,54 +184,37 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     run_pass(DeviceRange<Space>{ncells}, ClearCellsPass{cell_start_.data()});
     run_pass(all, CellBoundsPass{sorted_key_.data(), n_, cell_start_.data(), cell_end_.data()});
 
-    // Fluid rows: count, scan into offsets, fill (and sort).
-    count_.resize(n_ + 1);
-    count_.zero();
-    offsets_.resize(n_ + 1);
-    const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
-    GridRowPass<Dim, Real, std::uint64_t> rp{g,
-                                             d_.x.data(),
-                                             d_.h.data(),
-                                             d_.kind.data(),
-                                             xs_.data(),
-                                             sorted_idx_.data(),
-                                             cell_start_.data(),
-                                             cell_end_.data(),
-                                             false,
-                                             count_.data(),
-                                             nullptr,
-                                             nullptr};
-    run_pass(fluid, rp);
-    Ops::exclusive_scan(count_.data(), offsets_.data(), n_, scratch_);
-    rows_.resize(static_cast<std::size_t>(offsets_.get(n_)));
-    rp.offsets = offsets_.data();
-    rp.rows = rows_.data();
-    run_pass(fluid, rp);
+    // Fluid rows (all neighbours) and, for wall states, the wall rows (each wall's fluid neighbours).
+    fill_rows(g, fluid_, false, count_, offsets_, rows_);
+    if (wall_states_) fill_rows(g, boundary_, true, wall_count_, wall_start_, wall_rows_);
+  }
 
-    if (!wall_states_) return;
-    // Wall rows: the fluid neighbours of each wall particle.
-    wall_count_.resize(n_ + 1);
-    wall_count_.zero();
-    wall_start_.resize(n_ + 1);
-    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
-    GridRowPass<Dim, Real, std::uint32_t> wp{g,
-                                             d_.x.data(),
-                                             d_.h.data(),
-                                             d_.kind.data(),
-                                             xs_.data(),
-                                             sorted_idx_.data(),
-                                             cell_start_.data(),
-                                             cell_end_.data(),
-                                             true,
-                                             wall_count_.data(),
-                                             nullptr,
-                                             nullptr};
-    run_pass(boundary, wp);
-    Ops::exclusive_scan(wall_count_.data(), wall_start_.data(), n_, scratch_);
-    wall_rows_.resize(wall_start_.get(n_));
-    wp.offsets = wall_start_.data();
-    wp.rows = wall_rows_.data();
-    run_pass(boundary, wp);
+  // The rows of the particles in `set` over the grid `g`: count, exclusive scan into `offsets`, fill.
+  template <class Offset>
+  void fill_rows(const GridGeometry<Dim, Real>& g, const Array<std::uint32_t>& set, bool walls,
+                 Array<std::uint32_t>& count, Array<Offset>& offsets, Array<std::uint32_t>& rows) {
+    count.resize(n_ + 1);
+    count.zero();
+    offsets.resize(n_ + 1);
+    const DeviceIndexSet<Space> indices{set.data(), set.size()};
+    GridRowPass<Dim, Real, Offset> rp{g,
+                                      d_.x.data(),
+                                      d_.h.data(),
+                                      d_.kind.data(),
+                                      xs_.data(),
+                                      sorted_idx_.data(),
+                                      cell_start_.data(),
+                                      cell_end_.data(),
+                                      walls,
+                                      count.data(),
+                                      nullptr,
+                                      nullptr};
+    run_pass(indices, rp);
+    Ops::exclusive_scan(count.data(), offsets.data(), n_, scratch_);
+    rows.resize(static_cast<std::size_t>(offsets.get(n_)));
+    rp.offsets = offsets.data();
+    rp.rows = rows.data();
+    run_pass(indices, rp);
   }
 
   static constexpr std::size_t kMaxCells = std::size_t{1} << 30;
