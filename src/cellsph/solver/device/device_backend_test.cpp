@@ -131,6 +131,16 @@ TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu2D) {
   expect_same_steps(box.cfg, box.particles, 30);
 }
 
+// The continuity density with Fourtakas's density diffusion (models/continuity_density.hpp): the kick, the
+// rate, the update and the drift on the device, and the density carried from step to step.
+TEST_P(DeviceWalls, HostDeviceContinuityWithDiffusionIsBitIdenticalToTheCpu2D) {
+  auto box = test::weakly_viscous_box(Model::Wcsph, GetParam(), 0.5);
+  box.cfg.density_evolution = DensityEvolution::Continuity;
+  box.cfg.density_diffusion.kind = DensityDiffusion::Fourtakas;
+  box.cfg.density_diffusion.delta = 0.1;
+  expect_same_steps(box.cfg, box.particles, 30);
+}
+
 TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu3DFloatWithBoxAndPlane) {
   const float s = 0.04f;
   SolverConfig<3, float> cfg;

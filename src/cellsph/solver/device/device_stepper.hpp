@@ -23,6 +23,7 @@
 #include "cellsph/solver/device/device_stepper_base.hpp"
 #include "cellsph/solver/device/memory_space.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
+#include "cellsph/solver/models/continuity_density.hpp"
 #include "cellsph/solver/models/summation_density.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
 #include "cellsph/solver/particle_view.hpp"
@@ -66,7 +67,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     boundary_.upload(boundary.data(), boundary.size());
     rho0_.upload(rho0.data(), n_);
     wall_states_ = cfg_.wall_model != WallModel::Akinci && !boundary.empty();
-    for (auto* a : {&vol_, &prho2_}) {
+    for (auto* a : {&vol_, &prho2_, &drho_}) {
       a->resize(n_);
       a->zero();
     }
@@ -89,7 +90,10 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     const auto pv = view();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
     const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
-    summation_density(cfg_, pv, fluid);
+    if (continuity())
+      continuity_state(cfg_, pv, fluid);
+    else
+      summation_density(cfg_, pv, fluid);
     if (wall_states_) adami2012_wall_states(cfg_, pv, boundary);
     wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
     Ops::synchronize();
@@ -97,7 +101,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
 
     sw.reset();
     r.dt = global_courant_dt(cfg_, pv, fluid);
-    run_pass(fluid, WcsphSymplecticEulerPass<Dim, Real>{pv, r.dt});
+    integrate(pv, fluid, r.dt);
     if (cfg_.box.enabled || !cfg_.planes.empty()) {
       auto walls = box_plane_collisions(cfg_, pv);
       walls.planes = planes_.data();  // the device's copy of cfg.planes
@@ -136,6 +140,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.prho2 = prho2_.data();
     v.f_pressure = f_pressure_.data();
     v.wall_v = wall_v_.data();
+    v.drho = drho_.data();
     v.offsets = offsets_.data();
     v.candidates = rows_.data();
     v.within = rows_.data();
@@ -144,6 +149,21 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.wall_nbr = wall_rows_.data();
     v.phases = phases_.data();
     return v;
+  }
+
+  bool continuity() const { return cfg_.density_evolution == DensityEvolution::Continuity; }
+
+  // Simulation::integrate_wcsph's sequence: symplectic Euler, or with the continuity density the kick, the
+  // density rate at the old positions, the density update and the drift (models/continuity_density.hpp).
+  void integrate(const ParticleView<Dim, Real>& pv, const DeviceIndexSet<Space>& fluid, Real dt) {
+    if (!continuity()) {
+      run_pass(fluid, WcsphSymplecticEulerPass<Dim, Real>{pv, dt});
+      return;
+    }
+    run_pass(fluid, WcsphKickPass<Dim, Real>{pv, dt});
+    continuity_rate(cfg_, pv, fluid);
+    run_pass(fluid, ContinuityIntegratePass<Dim, Real>{pv, dt});
+    run_pass(fluid, WcsphDriftPass<Dim, Real>{pv, dt});
   }
 
   // The sorted grid (device_grid.hpp) and the rows of the fluid (and, for wall states, of the walls).
@@ -227,7 +247,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<PhaseParams<Real>> phases_;
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
-  Array<Real> rho0_, vol_, prho2_;
+  Array<Real> rho0_, vol_, prho2_, drho_;
   Array<V> f_pressure_, wall_v_;
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;

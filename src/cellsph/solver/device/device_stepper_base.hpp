@@ -60,8 +60,6 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.wall_model == WallModel::Dynamic)
     return "dynamic walls do not run on a device (boundary.model = akinci or adami)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
-  if (cfg.density_evolution == DensityEvolution::Continuity)
-    return "the continuity density does not run on a device yet (solver.density = summation)";
   return {};
 }
 
