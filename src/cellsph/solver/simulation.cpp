@@ -689,7 +689,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   steps_ = state.steps;
   leapfrog_started_ = state.leapfrog_started;
   if (device_) {
-    device_->upload(p_);
+    upload_to_device();
     host_stale_ = false;
   }
 }
@@ -709,8 +709,16 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
     throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
   sync_host();
   device_ = b == Backend::Cuda ? make_cuda_stepper(cfg_) : make_host_device_stepper(cfg_);
-  device_->upload(p_);
+  upload_to_device();
   backend_ = b;
+}
+
+// The particles and, for dynamic walls, their fixed wall-wall densities (init_boundary_weights).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::upload_to_device() {
+  device_->upload(p_);
+  if (cfg_.wall_model == WallModel::Dynamic && !boundary_.empty())
+    device_->upload_wall_self_density(wall_self_rho_);
 }
 
 // One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH

@@ -168,7 +168,8 @@ TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu3DFloatWithBoxAndPlane
   expect_same_steps(cfg, p, 25);
 }
 
-INSTANTIATE_TEST_SUITE_P(Device, DeviceWalls, ::testing::Values(WallModel::Akinci, WallModel::Adami),
+INSTANTIATE_TEST_SUITE_P(Device, DeviceWalls,
+                         ::testing::Values(WallModel::Akinci, WallModel::Adami, WallModel::Dynamic),
                          [](const auto& p) { return std::string(wall_model_name(p.param)); });
 
 TEST(DeviceBackend, SameBitsForAnyThreadCount) {

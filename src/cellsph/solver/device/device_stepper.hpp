@@ -17,6 +17,7 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/solver/boundary/adami2012.hpp"
+#include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_driver.hpp"
 #include "cellsph/solver/device/device_grid.hpp"
@@ -77,6 +78,11 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     }
   }
 
+  void upload_wall_self_density(const std::vector<Real>& rho) override {
+    CELLSPH_CHECK(rho.size() == n_, "one wall-wall density per particle");
+    wall_self_rho_.upload(rho.data(), n_);
+  }
+
   void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
 
   DeviceStepResult<Real> step() override {
@@ -94,7 +100,10 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       continuity_state(cfg_, pv, fluid);
     else
       summation_density(cfg_, pv, fluid);
-    if (wall_states_) adami2012_wall_states(cfg_, pv, boundary);
+    if (wall_states_ && cfg_.wall_model == WallModel::Dynamic)
+      dynamic_wall_states(cfg_, pv, boundary);
+    else if (wall_states_)
+      adami2012_wall_states(cfg_, pv, boundary);
     wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
     Ops::synchronize();
     r.forces_ms = sw.ms();
@@ -141,6 +150,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.f_pressure = f_pressure_.data();
     v.wall_v = wall_v_.data();
     v.drho = drho_.data();
+    v.wall_self_rho = wall_self_rho_.data();
     v.offsets = offsets_.data();
     v.candidates = rows_.data();
     v.within = rows_.data();
@@ -247,7 +257,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<PhaseParams<Real>> phases_;
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
-  Array<Real> rho0_, vol_, prho2_, drho_;
+  Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
   Array<V> f_pressure_, wall_v_;
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;

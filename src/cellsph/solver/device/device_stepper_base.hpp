@@ -41,6 +41,9 @@ class DeviceStepperBase {
   // Every field of the field list (particles.hpp) to the device (the index sets and rest densities are
   // derived from them there).
   virtual void upload(const Particles<Dim, Real>& p) = 0;
+  // Dynamic walls: each wall particle's fixed wall-wall density (boundary/dynamic_crespo2007.hpp), which the
+  // Simulation computes once from rows the device does not build; after upload(), indexed like its particles.
+  virtual void upload_wall_self_density(const std::vector<Real>& rho) = 0;
   // Every field back into p (resized).
   virtual void download(Particles<Dim, Real>& p) = 0;
   // One step of Simulation::step() for WCSPH with a global step: neighbour rows, density, wall states,
@@ -57,8 +60,6 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.model != Model::Wcsph) return "only the WCSPH model runs on a device (solver.model = wcsph)";
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
-  if (cfg.wall_model == WallModel::Dynamic)
-    return "dynamic walls do not run on a device (boundary.model = akinci or adami)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
   return {};
 }
