@@ -721,11 +721,12 @@ void Simulation<Dim, Real>::upload_to_device() {
     device_->upload_wall_self_density(wall_self_rho_);
 }
 
-// One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH
-// with global steps, on the device's copy of the particles.
+// One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH or
+// the paper's model with global steps, on the device's copy of the particles.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step_device() {
-  const DeviceStepResult<Real> r = device_->step();
+  const DeviceStepResult<Real> r = device_->step(last_dt_, leapfrog_started_);
+  if (cfg_.model == Model::PaperMultiphase) leapfrog_started_ = true;
   host_stale_ = true;
   timings_.neighbors += r.neighbors_ms;
   timings_.forces += r.forces_ms;

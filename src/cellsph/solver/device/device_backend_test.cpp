@@ -141,6 +141,18 @@ TEST_P(DeviceWalls, HostDeviceContinuityWithDiffusionIsBitIdenticalToTheCpu2D) {
   expect_same_steps(box.cfg, box.particles, 30);
 }
 
+// The paper's model (models/paper_multiphase.hpp): its forces with each tension model (the CSF and Akinci
+// ones through the colour normals) and its leap-frog.
+TEST_P(DeviceWalls, HostDevicePaperModelIsBitIdenticalToTheCpu2D) {
+  for (const auto tension : {TensionModel::Paper, TensionModel::Csf, TensionModel::Akinci}) {
+    auto box = test::weakly_viscous_box(Model::PaperMultiphase, GetParam(), 0.5);
+    box.cfg.phases[0].sigma = 0.05;
+    box.cfg.tension = tension;
+    SCOPED_TRACE(static_cast<int>(tension));
+    expect_same_steps(box.cfg, box.particles, 30);
+  }
+}
+
 TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu3DFloatWithBoxAndPlane) {
   const float s = 0.04f;
   SolverConfig<3, float> cfg;
@@ -204,8 +216,11 @@ TEST(DeviceBackend, StateStaysOnTheDeviceUntilAsked) {
 }
 
 // A checkpoint (particles + integrator state) taken on one backend resumes on the other, bit for bit.
-TEST(DeviceBackend, CheckpointsResumeAcrossBackends) {
-  auto box = test::weakly_viscous_box(Model::Wcsph, WallModel::Adami, 0.5);
+// The paper model's leap-frog carries its state (the last step, whether it has started) across too.
+class DeviceResume : public ::testing::TestWithParam<Model> {};
+
+TEST_P(DeviceResume, CheckpointsResumeAcrossBackends) {
+  auto box = test::weakly_viscous_box(GetParam(), WallModel::Adami, 0.5);
   Simulation<2, double> whole(box.cfg, box.particles);
   for (int s = 0; s < 30; ++s) whole.step();
   for (const bool device_first : {true, false}) {
@@ -227,6 +242,9 @@ TEST(DeviceBackend, CheckpointsResumeAcrossBackends) {
   for (int s = 0; s < 15; ++s) mixed.step();
   EXPECT_TRUE(same_state(whole.particles(), mixed.particles()));
 }
+
+INSTANTIATE_TEST_SUITE_P(Device, DeviceResume, ::testing::Values(Model::Wcsph, Model::PaperMultiphase),
+                         [](const auto& p) { return std::string(model_name(p.param)); });
 
 TEST(DeviceBackend, UnstableRunGivesTheCpuDiagnosis) {
   auto box = test::weakly_viscous_box(Model::Wcsph, WallModel::Akinci, 0.5);
@@ -262,9 +280,9 @@ TEST(DeviceBackend, UnsupportedConfigsAreInputErrors) {
     sim.step();  // still usable on the CPU
   };
   auto cfg = test::wcsph_water(0.02, 10);
-  auto paper = cfg;
-  paper.model = Model::PaperMultiphase;
-  expect_refused(paper, "only the WCSPH model");
+  auto dfsph = cfg;
+  dfsph.model = Model::Dfsph;
+  expect_refused(dfsph, "DFSPH does not run on a device");
   auto reorder = cfg;
   reorder.reorder_every = 10;
   expect_refused(reorder, "neighbors.reorder_every");

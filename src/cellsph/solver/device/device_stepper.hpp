@@ -25,6 +25,7 @@
 #include "cellsph/solver/device/memory_space.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
 #include "cellsph/solver/models/continuity_density.hpp"
+#include "cellsph/solver/models/paper_multiphase.hpp"
 #include "cellsph/solver/models/summation_density.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
 #include "cellsph/solver/particle_view.hpp"
@@ -85,7 +86,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
 
   void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
 
-  DeviceStepResult<Real> step() override {
+  DeviceStepResult<Real> step(Real last_dt, bool leapfrog_started) override {
     DeviceStepResult<Real> r;
     Stopwatch sw;
     build_rows();
@@ -104,13 +105,21 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       dynamic_wall_states(cfg_, pv, boundary);
     else if (wall_states_)
       adami2012_wall_states(cfg_, pv, boundary);
-    wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
+    if (paper())
+      forces_paper(pv, fluid);
+    else
+      wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
     Ops::synchronize();
     r.forces_ms = sw.ms();
 
     sw.reset();
     r.dt = global_courant_dt(cfg_, pv, fluid);
-    integrate(pv, fluid, r.dt);
+    if (paper()) {
+      const Real kick = leapfrog_started ? (last_dt + r.dt) / 2 : r.dt / 2;  // Simulation::integrate_paper
+      run_pass(fluid, PaperLeapFrogPass<Dim, Real>{pv, kick, r.dt});
+    } else {
+      integrate(pv, fluid, r.dt);
+    }
     if (cfg_.box.enabled || !cfg_.planes.empty()) {
       auto walls = box_plane_collisions(cfg_, pv);
       walls.planes = planes_.data();  // the device's copy of cfg.planes
@@ -159,6 +168,24 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.wall_nbr = wall_rows_.data();
     v.phases = phases_.data();
     return v;
+  }
+
+  bool paper() const { return cfg_.model == Model::PaperMultiphase; }
+
+  // Simulation::compute_forces_paper: the colour normals (every particle's cleared first) when the tension
+  // model needs them, then the forces (models/paper_multiphase.hpp).
+  void forces_paper(const ParticleView<Dim, Real>& pv, const DeviceIndexSet<Space>& fluid) {
+    const auto tension = PaperTension::of(cfg_, any_tension_);
+    if (tension.needs_normals()) {
+      normal_.resize(n_);
+      normal_.zero();
+      auto with_normals = pv;
+      with_normals.normal = normal_.data();
+      paper_normals(cfg_, with_normals, fluid);
+      paper_forces(cfg_, with_normals, fluid, tension, wall_states_);
+      return;
+    }
+    paper_forces(cfg_, pv, fluid, tension, wall_states_);
   }
 
   bool continuity() const { return cfg_.density_evolution == DensityEvolution::Continuity; }
@@ -258,7 +285,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
   Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
-  Array<V> f_pressure_, wall_v_;
+  Array<V> f_pressure_, wall_v_, normal_;
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;
   Array<V> xs_;
