@@ -64,6 +64,23 @@ TEST(DeviceMemory, MirrorCopiesEveryFieldBothWays) {
 }
 
 // The grid's rows against all pairs: row i = every j != i with distance2 <= h_i^2, ascending.
+// The device's sum (DFSPH's average errors) has the CPU's bits.
+TEST(DeviceDriver, ReduceSumEqualsTheCpusBits) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> value(4000);
+  for (double& v : value) v = u(rng) * 1e-3 + (rng() % 7 == 0 ? 1e3 : 0.0);
+  std::vector<std::uint32_t> idx;
+  for (std::uint32_t i = 0; i < 4000; ++i)
+    if (rng() % 4 != 0) idx.push_back(i);
+  DeviceArray<std::uint32_t, HostDeviceSpace> dev_idx;
+  dev_idx.upload(idx.data(), idx.size());
+  auto pass = [&](std::size_t i) { return value[i]; };
+  const double cpu = reduce_sum(IndexSet(idx.begin(), idx.end()), pass);
+  EXPECT_EQ(reduce_sum(DeviceIndexSet<HostDeviceSpace>{dev_idx.data(), idx.size()}, pass), cpu);
+  EXPECT_GT(cpu, 0.0);
+}
+
 TEST(DeviceGrid, RowsEqualBruteForceIncludingWallRows) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
