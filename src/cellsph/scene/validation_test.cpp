@@ -29,11 +29,12 @@ constexpr double kG = 9.81;
 // So 20% for the RMS (the coarse run's 2-particle-deep layers, 3-9 points above the fine run) and 10% for
 // the arrivals (the fine run's lead, which the coarse run shares).
 constexpr double kLobovskyRms = 0.20, kLobovskyArrival = 0.10;
-// spheric-test2 at 0.05 m until 1 s: level RMS 24.2% (x = 1.488 m), 6.6% (0.992 m), 3.0% (the column)
+// spheric-test2 at 0.05 m until 1 s: level RMS 24.8% (x = 1.488 m), 6.9% (0.992 m), 3.0% (the column)
 // of the peak; arrivals -0.014 and 0.000 s; P1's peak +0.011 s, 2.8 times the measured 11.2 kPa, and its
-// mean over 0.45-1 s +2%. At 0.04 m (2 s): 24.5%, 15.9%, 2.5%; +0.014 and +0.003 s; P1 +0.035 s, 4.3
-// times, mean +28%. Summation density's pressure is noisy (docs/physics.md): its peak is a spike of one
-// sample, which the bound of 5 times only keeps from blowing up; the mean after the impact is the load.
+// mean over 0.45-1 s +1.2%. Finer, to 2 s: 24.5%, 15.9%, 2.5%; +0.014 and +0.003 s; P1 +0.035 s, 4.3
+// times, mean +28% at 0.04 m; 17.8%, 8.6%, 0.7%; +0.013, +0.008 s; +0.010 s, 3.4 times, +27% at 0.03 m.
+// Summation density's pressure is noisy (docs/physics.md): its peak is a spike of one sample, which the
+// bound of 5 times only keeps from blowing up; the mean after the impact is the load.
 constexpr double kSphericRms = 0.35, kSphericArrival = 0.03, kSphericP1Time = 0.04, kSphericP1Peak = 4.0,
                  kSphericP1Mean = 0.5;
 
