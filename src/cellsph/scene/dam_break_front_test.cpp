@@ -27,7 +27,8 @@ class DamBreakFront : public ::testing::TestWithParam<std::string> {};
 // Martin & Moyce's residual column height at the back wall (data/validation/martin_moyce_1952.txt):
 // table [B] (a square column, n^2 = 1: h(x = 0)/a against t sqrt(g / a)) and the residual table of [A]
 // (n^2 = 2, the scene's 1 m x 2 m column: h / (2a) against t sqrt(g / a)). A wall that holds the water
-// (the former 6.26 Pa s written as a viscosity, no-slip) keeps the column high at the wall; one that lets
+// (the former 6.26 Pa s written as a viscosity, no-slip: 0.185 off table [A] at 0.1 m, 0.118 off [B] at
+// 0.05 m) keeps the column high at the wall; one that lets
 // particles cling leaves a trail above the surface. Returns table `index` (1: the front, 2: the residual
 // height) of section "[A]" or "[B]" as pairs of numbers.
 std::vector<std::pair<double, double>> martin_moyce(const std::string& table, int index = 2) {
