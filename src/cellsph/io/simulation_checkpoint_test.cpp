@@ -299,6 +299,22 @@ TEST(SimulationCheckpoint, ValuesNoRunHoldsAreRefusedNamingTheParticle) {
   EXPECT_NE(error(good, {std::nan(""), 1e-3, 7, false}).find("simulated time nan"), std::string::npos);
   EXPECT_NE(error(good, {0.5, -1, 7, false}).find("last step -1.000000 is not a finite number >= 0"),
             std::string::npos);
+  // The solver state: one finite entry per particle (or none).
+  auto state_error = [&](const SolverState<2, double>& ss) -> std::string {
+    try {
+      sim.restore(good, st, "checkpoint 'c'", ss);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  SolverState<2, double> ss;
+  ss.dfsph_kappa_v.assign(good.size() - 1, 0.0);
+  EXPECT_EQ(state_error(ss),
+            "checkpoint 'c': holds 8 entries of the solver state 'dfsph_kappa_v' for 9 particles");
+  ss.dfsph_kappa_v.assign(good.size(), 0.0);
+  ss.dfsph_kappa_v[5] = std::nan("");
+  EXPECT_EQ(state_error(ss), "checkpoint 'c': particle 5 has a non-finite dfsph_kappa_v");
   EXPECT_EQ(sim.steps(), 0u) << "untouched on error (the one success above restored step 0)";
   EXPECT_EQ(error(good, st), "no error");
   EXPECT_EQ(sim.steps(), 7u);
