@@ -122,9 +122,9 @@ inline CheckpointHeader parse_header(Cursor& c) {
     c.fail("bad magic number: not a cellsph checkpoint");
   CheckpointHeader h;
   h.version = c.get<std::uint32_t>("the format version");
-  if (h.version != kCheckpointVersion)
-    c.fail("format version " + std::to_string(h.version) + " is not supported (this build reads version " +
-           std::to_string(kCheckpointVersion) + ")");
+  if (h.version < kCheckpointOldestVersion || h.version > kCheckpointVersion)
+    c.fail("format version " + std::to_string(h.version) + " is not supported (this build reads versions " +
+           std::to_string(kCheckpointOldestVersion) + " to " + std::to_string(kCheckpointVersion) + ")");
   if (c.get<std::uint32_t>("the byte-order mark") != kByteOrderMark)
     c.fail("byte-order mark mismatch (written on a machine of other endianness, or corrupted)");
   h.dim = static_cast<int>(c.get<std::uint32_t>("the dimension"));
@@ -141,12 +141,47 @@ inline const char* precision_name(int size) {
 
 }  // namespace io::detail
 
-// Generic over the particle type (size(), resize(), for_each_field() and a position vector x); the
-// public functions instantiate them for Particles, tests for an extended field list.
+// The fields of a checkpoint as one list: the particles' fields, then the solver state's. P is Particles or
+// a const reference to them (writing), S likewise.
+template <class P, class S>
+struct CheckpointFields {
+  using V = typename std::remove_cvref_t<P>::V;
+  P particles;
+  S state;
+
+  template <class Self, class F>
+  static void for_each_field(Self& self, F&& fn) {
+    std::remove_cvref_t<P>::for_each_field(self.particles, fn);
+    std::remove_cvref_t<S>::for_each_field(self.state, fn);
+  }
+  template <class F>
+  void for_each_field(F&& fn) {
+    for_each_field(*this, fn);
+  }
+  template <class F>
+  void for_each_field(F&& fn) const {
+    for_each_field(*this, fn);
+  }
+  [[nodiscard]] std::size_t size() const { return particles.size(); }
+  void resize(std::size_t n) {
+    for_each_field([n](std::string_view, auto& field) { field.resize(n); });
+  }
+  // Fields a file of `version` may lack (then left at 0): the solver state came with version 2.
+  [[nodiscard]] bool absent_before(std::string_view name, std::uint32_t version) const {
+    bool state_field = false;
+    std::remove_cvref_t<S>::for_each_field(
+        state, [&](std::string_view n, const auto&) { state_field = state_field || n == name; });
+    return state_field && version < 2;
+  }
+};
+
+// Generic over the particle type (a vector type V, size(), resize(), for_each_field(), and optionally
+// absent_before(name, version) for fields older versions lack); the public functions instantiate them for
+// CheckpointFields, tests for an extended field list.
 template <class P>
 void write_checkpoint_any(const P& particles, const CheckpointInfo& info, const std::filesystem::path& path) {
   using namespace io::detail;
-  using V = std::remove_cvref_t<decltype(particles.x[0])>;
+  using V = typename P::V;
   constexpr int Dim = V::dim;
   using Real = typename V::scalar;
   std::string out;
@@ -185,7 +220,7 @@ void write_checkpoint_any(const P& particles, const CheckpointInfo& info, const 
 template <class P>
 CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particles) {
   using namespace io::detail;
-  using V = std::remove_cvref_t<decltype(particles.x[0])>;
+  using V = typename P::V;
   constexpr int Dim = V::dim;
   using Real = typename V::scalar;
   const std::string bytes = read_all(path);
@@ -211,7 +246,11 @@ CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particl
 
   // Before allocating: a corrupt count must not ask for more memory than the file could fill.
   std::size_t per_particle = 0;
-  particles.for_each_field([&](std::string_view, const auto& field) { per_particle += sizeof(field[0]); });
+  particles.for_each_field([&](std::string_view name, const auto& field) {
+    if constexpr (requires { particles.absent_before(name, h.version); })
+      if (particles.absent_before(name, h.version)) return;
+    per_particle += sizeof(field[0]);
+  });
   if (per_particle && h.count > (body - c.pos()) / per_particle)
     c.fail("truncated or corrupt: " + std::to_string(h.count) +
            " particles need more bytes than the file has");
@@ -249,8 +288,12 @@ CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particl
     });
     CELLSPH_CHECK(found, name);
   }
-  for (const auto& name : known)
-    if (!seen.count(name)) c.fail("missing field '" + name + "'");
+  for (const auto& name : known) {
+    if (seen.count(name)) continue;
+    if constexpr (requires { loaded.absent_before(name, h.version); })
+      if (loaded.absent_before(name, h.version)) continue;  // 0, as resize left it
+    c.fail("missing field '" + name + "'");
+  }
   if (c.pos() != body)
     c.fail(std::to_string(body - c.pos()) +
            " unexpected bytes after the last field (corrupted or wrong format)");

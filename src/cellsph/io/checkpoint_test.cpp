@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -58,6 +59,44 @@ TEST(Checkpoint, RoundTripIsBitExact2DFloat) {
 }
 TEST(Checkpoint, RoundTripIsBitExact3DDouble) {
   check_round_trip<3, double>();
+}
+
+// The solver state (solver/particles.hpp) is written after the particle fields and read back bit for bit.
+TEST(Checkpoint, SolverStateRoundTrips) {
+  test::TempDir dir("ckpt_state");
+  const auto p = test::make_particles<2, double>(7);
+  SolverState<2, double> state;
+  state.dfsph_kappa_v = {1e-9, -0.0, 2.5, 3e300, -4, 5, 6};
+  write_checkpoint(p, state, {1.0, 2, ""}, dir / "c.ckpt");
+  Particles<2, double> q;
+  SolverState<2, double> back;
+  read_checkpoint(dir / "c.ckpt", q, back);
+  EXPECT_TRUE(same_bits(back.dfsph_kappa_v, state.dfsph_kappa_v));
+  EXPECT_TRUE(same_bits(q.x, p.x));
+  // Written without a state: 0 for every particle.
+  write_checkpoint(p, {1.0, 2, ""}, dir / "z.ckpt");
+  read_checkpoint(dir / "z.ckpt", q, back);
+  EXPECT_EQ(back.dfsph_kappa_v, std::vector<double>(7, 0.0));
+}
+
+// A format-1 file (the checkpoint fuzzer's seed fuzz/corpus/checkpoint/checkpoint-2d.bin, written by a
+// build before the solver state existed: 33 particles of a 2D double run at t = 0.03 s, step 3) is still
+// read, with a solver state of 0 (what that build resumed with).
+TEST(Checkpoint, Version1FileIsReadWithAZeroSolverState) {
+  const std::filesystem::path file = CELLSPH_SOURCE_DIR "/fuzz/corpus/checkpoint/checkpoint-2d.bin";
+  const auto h = read_checkpoint_header(file);
+  EXPECT_EQ(h.version, 1u);
+  Particles<2, double> q;
+  SolverState<2, double> state;
+  state.dfsph_kappa_v = {1.0};
+  const auto info = read_checkpoint(file, q, state);
+  EXPECT_EQ(info.step, 3u);
+  EXPECT_EQ(info.time, 0.03);
+  ASSERT_EQ(q.size(), 33u);
+  EXPECT_EQ(state.dfsph_kappa_v, std::vector<double>(33, 0.0));
+  std::vector<std::uint32_t> ids(q.id.begin(), q.id.end());
+  std::sort(ids.begin(), ids.end());
+  for (std::uint32_t k = 0; k < 33; ++k) EXPECT_EQ(ids[k], k);
 }
 
 TEST(Checkpoint, EmptyParticleSet) {
@@ -147,14 +186,25 @@ TEST_F(CheckpointErrors, UnknownAndMissingFields) {
   const auto unknown = with([&](std::string& b) { b.replace(pos, 9, "viscosit2"); });
   EXPECT_NE(unknown.find("unknown field 'viscosit2'"), std::string::npos) << unknown;
 
-  // Drop the last field ("id": 4-byte name length, name, size, count, data) and lower the count.
+  // Drop the last particle field ("id": 4-byte name length, name, size, count, data; the solver state
+  // follows) and lower the count.
   const auto lvl = good_.rfind(std::string("\x02\0\0\0id", 6));
+  const auto state_at = good_.find(std::string("\x0d\0\0\0dfsph_kappa_v", 17), lvl);
+  ASSERT_NE(state_at, std::string::npos);
   const auto missing = with([&](std::string& b) {
     const std::size_t nfields_at = 8 + 4 * 4 + 8 * 3 + 8 + 5;  // header, user blob "state"
     b[nfields_at] = static_cast<char>(b[nfields_at] - 1);
-    b.erase(lvl, b.size() - 8 - lvl);
+    b.erase(lvl, state_at - lvl);
   });
   EXPECT_NE(missing.find("missing field 'id'"), std::string::npos) << missing;
+
+  // A version-2 file must hold the solver state (only version 1 predates it).
+  const auto no_state = with([&](std::string& b) {
+    const std::size_t nfields_at = 8 + 4 * 4 + 8 * 3 + 8 + 5;
+    b[nfields_at] = static_cast<char>(b[nfields_at] - 1);
+    b.erase(state_at, b.size() - 8 - state_at);
+  });
+  EXPECT_NE(no_state.find("missing field 'dfsph_kappa_v'"), std::string::npos) << no_state;
 
   const auto dup = with([&](std::string& b) { b.replace(b.rfind("level"), 5, "phase"); });
   EXPECT_NE(dup.find("field 'phase' appears twice"), std::string::npos) << dup;

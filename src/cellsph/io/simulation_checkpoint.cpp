@@ -64,7 +64,7 @@ void write_simulation_checkpoint(const Simulation<Dim, Real>& sim, std::string_v
   put(info.user, static_cast<std::uint8_t>(st.leapfrog_started));
   put(info.user, static_cast<std::uint64_t>(extra.size()));
   info.user.append(extra);
-  write_checkpoint(sim.particles(), info, path);
+  write_checkpoint(sim.particles(), sim.solver_state(), info, path);
 }
 
 namespace {
@@ -106,9 +106,10 @@ std::string read_extra(const std::filesystem::path& path) {
 template <int Dim, class Real>
 std::string read_simulation_checkpoint(const std::filesystem::path& path, Simulation<Dim, Real>& sim) {
   Particles<Dim, Real> particles;
-  const CheckpointInfo info = read_checkpoint(path, particles);
+  SolverState<Dim, Real> solver;
+  const CheckpointInfo info = read_checkpoint(path, particles, solver);
   auto [st, extra] = parse_blob<Real>(path, info);
-  sim.restore(std::move(particles), st, "checkpoint '" + path.string() + "'");
+  sim.restore(std::move(particles), st, "checkpoint '" + path.string() + "'", std::move(solver));
   return extra;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // A Simulation's checkpoint in the io/checkpoint.hpp format (`cellsph run` writes it as checkpoint.bin and
-// reads it for --resume): the particles are its fields, the simulated time and step count its header, and
-// its user blob holds the rest of the integrator state and the caller's own bytes:
+// reads it for --resume): the particles and the solver state are its fields, the simulated time and step
+// count its header, and its user blob holds the rest of the integrator state and the caller's own bytes:
 //
 //   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data
 //

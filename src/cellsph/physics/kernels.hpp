@@ -5,6 +5,9 @@
 // Every kernel here has compact support h (W = 0 for r > h) and integrates to 1 over its support in
 // the dimension it is instantiated for. Derivatives are written as radial functions:
 //   gradW(r) = W'(r) r/|r|,   laplacian(r) = W''(r) + (Dim - 1) W'(r) / r.
+// gradW_factor(r) is the scalar W'(|r|)/|r| of that gradient, computed as gradW computes it: within the
+// support gradW(r) and r * gradW_factor(r) have the same bits (beyond it both are zero, up to the sign of
+// zero), so a caller that keeps r may store one scalar per pair instead of a vector (models/dfsph.hpp).
 //
 // Notes on the paper's printed constants (checked by the normalisation and finite-difference tests):
 //  * eq. 10 prints the viscosity kernel with 15/(2 pi h^6); Mueller et al. (2003) use 15/(2 pi h^3),
@@ -74,6 +77,12 @@ struct Poly6Kernel {
     const Real d = h2 - r2;
     return rv * (Real(-6) * sigma * d * d);
   }
+  CELLSPH_HD Real gradW_factor(const Vec<Dim, Real>& rv) const {
+    const Real r2 = norm2(rv);
+    if (r2 > h2) return 0;
+    const Real d = h2 - r2;
+    return Real(-6) * sigma * d * d;
+  }
   CELLSPH_HD Real laplacian(Real r) const {
     if (r > h) return 0;
     const Real r2 = r * r, d = h2 - r2;
@@ -104,6 +113,10 @@ struct SpikyKernel {
   CELLSPH_HD Vec<Dim, Real> gradW(const Vec<Dim, Real>& rv) const {
     const Real r = norm(rv);
     return detail::radial(rv, r, dW(r));
+  }
+  CELLSPH_HD Real gradW_factor(const Vec<Dim, Real>& rv) const {
+    const Real r = norm(rv);
+    return r > Real(0) ? dW(r) / r : Real(0);
   }
   // Singular at r = 0 (a cusp); defined for r > 0 only.
   CELLSPH_HD Real laplacian(Real r) const {
@@ -152,6 +165,10 @@ struct ViscosityKernel {
     const Real r = norm(rv);
     return detail::radial(rv, r, dW(r));
   }
+  CELLSPH_HD Real gradW_factor(const Vec<Dim, Real>& rv) const {
+    const Real r = norm(rv);
+    return r > Real(0) ? dW(r) / r : Real(0);
+  }
   CELLSPH_HD Real laplacian(Real r) const { return r > h ? Real(0) : lap * (h - r); }
 };
 
@@ -182,6 +199,10 @@ struct CubicSplineKernel {
   CELLSPH_HD Vec<Dim, Real> gradW(const Vec<Dim, Real>& rv) const {
     const Real r = norm(rv);
     return detail::radial(rv, r, dW(r));
+  }
+  CELLSPH_HD Real gradW_factor(const Vec<Dim, Real>& rv) const {
+    const Real r = norm(rv);
+    return r > Real(0) ? dW(r) / r : Real(0);
   }
   // Finite at r = 0 from the limit W'(r)/r -> -12 sigma / h^2.
   CELLSPH_HD Real laplacian(Real r) const {
@@ -223,6 +244,13 @@ struct WendlandC2Kernel {
     if (q > 1) return Vec<Dim, Real>{};
     const Real d = 1 - q;
     return rv * (Real(-20) * sigma * inv_h * inv_h * d * d * d);
+  }
+  CELLSPH_HD Real gradW_factor(const Vec<Dim, Real>& rv) const {
+    const Real r = norm(rv);
+    const Real q = r * inv_h;
+    if (q > 1) return 0;
+    const Real d = 1 - q;
+    return Real(-20) * sigma * inv_h * inv_h * d * d * d;
   }
   CELLSPH_HD Real laplacian(Real r) const {
     const Real q = r * inv_h;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <numbers>
 
 #include "cellsph/physics/kernels.hpp"
@@ -162,6 +164,45 @@ TEST(Kernels, FloatMatchesDouble) {
   const Poly6Kernel<3, float> kf(0.7f);
   const Poly6Kernel<3, double> kd(kH);
   EXPECT_NEAR(kf.W(0.3f), kd.W(0.3), 1e-5 * kd.W(0.3));
+}
+
+// gradW_factor is the scalar of the gradient: r * gradW_factor(r) has gradW(r)'s bits for every kernel,
+// dimension and precision inside the support, and is zero beyond it (models/dfsph.hpp stores the scalar and
+// rebuilds the vector, and relies on it for results identical to recomputing gradW).
+template <int Dim, class Real>
+void check_gradient_factor() {
+  std::uint64_t state = 12345;
+  auto uniform = [&state] {  // a fixed LCG: the same samples on every platform
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) / double(1ull << 53);
+  };
+  for (const KernelKind kind : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity,
+                                KernelKind::CubicSpline, KernelKind::WendlandC2}) {
+    with_kernel<Dim, Real>(kind, Real(kH), [&](const auto w) {
+      for (int k = 0; k < 2000; ++k) {
+        Vec<Dim, Real> rv;
+        for (int a = 0; a < Dim; ++a) rv[a] = Real((2 * uniform() - 1) * 1.2 * kH);
+        const auto g = w.gradW(rv);
+        const auto rebuilt = rv * w.gradW_factor(rv);
+        const bool inside = norm(rv) <= Real(kH);
+        for (int a = 0; a < Dim; ++a) {
+          if (inside)
+            ASSERT_EQ(std::memcmp(&g[a], &rebuilt[a], sizeof(Real)), 0)
+                << kernel_name(kind) << " " << Dim << "D sample " << k << " axis " << a << ": " << g[a]
+                << " vs " << rebuilt[a];
+          else  // beyond the support both are zero (x_ij * 0 may be -0)
+            ASSERT_TRUE(g[a] == 0 && rebuilt[a] == 0) << kernel_name(kind) << " sample " << k;
+        }
+      }
+    });
+  }
+}
+
+TEST(Kernels, GradientFactorRebuildsTheGradientsBits) {
+  check_gradient_factor<2, float>();
+  check_gradient_factor<2, double>();
+  check_gradient_factor<3, float>();
+  check_gradient_factor<3, double>();
 }
 
 TEST(Kernels, NamesRoundTrip) {

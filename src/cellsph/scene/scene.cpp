@@ -1124,6 +1124,42 @@ void set_view(Scene<Dim, Real>& s, const std::optional<Aabb<Dim>>& container) {
   s.view_hi = hi;
 }
 
+// A scene switched to DFSPH (`--set /solver/model=dfsph` on a WCSPH scene) may keep settings of the
+// other models that DFSPH refuses: one message names them all, with the --set edits that make the scene
+// fit, rather than one refusal per run (docs/physics.md, "Model 3").
+void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
+  const auto at = [](const nlohmann::json& o, const char* key) -> const nlohmann::json* {
+    return o.is_object() && o.contains(key) ? &o[key] : nullptr;
+  };
+  const nlohmann::json* solver = at(j, "solver");
+  const nlohmann::json* model = solver ? at(*solver, "model") : nullptr;
+  if (!model || *model != "dfsph") return;
+  std::string what, sets;
+  auto add = [&](const std::string& w, const std::string& set) {
+    what += what.empty() ? "" : "; ";
+    what += w;
+    sets += sets.empty() ? "" : " ";
+    sets += set;
+  };
+  const nlohmann::json* boundary = at(j, "boundary");
+  if (const nlohmann::json* wm = boundary ? at(*boundary, "model") : nullptr;
+      wm && wm->is_string() && *wm != "akinci")
+    add("/boundary/model is " + json_value_text(*wm) + " (DFSPH holds Akinci 2012 boundary particles only)",
+        "--set /boundary/model=akinci");
+  const nlohmann::json* av = at(*solver, "artificial_viscosity");
+  if (const nlohmann::json* alpha = av ? at(*av, "alpha") : nullptr;
+      alpha && alpha->is_number() && alpha->get<double>() > 0)
+    add("/solver/artificial_viscosity/alpha is " + json_value_text(*alpha) +
+            " (artificial viscosity is part of the WCSPH model)",
+        "--set /solver/artificial_viscosity/alpha=0");
+  if (const nlohmann::json* d = at(*solver, "density"); d && *d == "continuity")
+    add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model)",
+        "--set /solver/density=mass");
+  if (what.empty()) return;
+  throw InputError(source + ": /solver/model = \"dfsph\" does not fit this scene's settings: " + what +
+                   ". Add: " + sets);
+}
+
 }  // namespace
 
 template <int Dim, class Real>
@@ -1143,6 +1179,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   s.spacing = static_cast<Real>(spacing);
   auto& cfg = s.solver;
   const PhaseTable phases = read_phases(r, spacing, cfg);
+  check_dfsph_fits(j, source);
   read_solver(r, spacing, cfg);
   read_time(r, cfg, s.output);
   read_neighbors(r, cfg);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include "cellsph/core/error.hpp"
@@ -282,6 +283,48 @@ TEST(Dfsph, SceneKeys) {
   }
   const std::string msg = scene_error("wcsph", "{}");
   EXPECT_NE(msg.find("/solver/dfsph"), std::string::npos) << msg;
+}
+
+// The built-in WCSPH scene dam-break-3d switched with `--set /solver/model=dfsph`: one message names each
+// setting DFSPH refuses (Adami walls, the artificial viscosity) and the exact --set edits that fit; with
+// them the scene loads (a DFSPH scene with Akinci walls), as does the built-in dam-break-3d-dfsph.
+TEST(Dfsph, WcsphSceneSwitchedNamesTheSetEditsItNeeds) {
+  auto load = [](const std::string& name, const std::vector<std::string>& edits) -> std::string {
+    std::string src;
+    auto j = read_scene_json(name, src);
+    apply_scene_edits(j, edits, src);
+    try {
+      const auto sc = load_scene<3, float>(j, src);
+      EXPECT_EQ(sc.solver.model, Model::Dfsph);
+      EXPECT_EQ(sc.solver.wall_model, WallModel::Akinci);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string msg = load("dam-break-3d", {"/solver/model=dfsph"});
+  EXPECT_NE(msg.find("/boundary/model is \"adami\""), std::string::npos) << msg;
+  EXPECT_NE(msg.find("/solver/artificial_viscosity/alpha is 0.01"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Add: --set /boundary/model=akinci --set /solver/artificial_viscosity/alpha=0"),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(load("dam-break-3d",
+                 {"/solver/model=dfsph", "/boundary/model=akinci", "/solver/artificial_viscosity/alpha=0"}),
+            "");
+  // The continuity density is named too (dam-break-3d sums its density).
+  const std::string cont =
+      load("dam-break-3d", {"/solver/model=dfsph", "/boundary/model=akinci",
+                            "/solver/artificial_viscosity/alpha=0", "/solver/density=continuity"});
+  EXPECT_NE(cont.find("Add: --set /solver/density=mass"), std::string::npos) << cont;
+  // The built-in 3D DFSPH scene at about 10^5 fluid particles.
+  std::string src;
+  const auto j = read_scene_json("dam-break-3d-dfsph", src);
+  const auto sc = load_scene<3, float>(j, src);
+  EXPECT_EQ(sc.solver.model, Model::Dfsph);
+  EXPECT_EQ(sc.solver.wall_model, WallModel::Akinci);
+  std::size_t fluid = 0;
+  for (const auto k : sc.particles.kind) fluid += k == 0;
+  EXPECT_EQ(fluid, 37u * 74u * 37u);
 }
 
 }  // namespace

@@ -56,7 +56,8 @@ struct ParticleView {
   Real* df_alpha = nullptr;       // DFSPH (models/dfsph.hpp): 1 / (the factor's denominator)
   Real* df_kappa = nullptr;       // DFSPH: this sweep's pressure / rho^2 increment
   Real* df_kappa_v = nullptr;     // DFSPH: the divergence solve's pressure / rho^2 (warm start)
-  V* df_grad = nullptr;           // DFSPH: grad W of each pair of the rows, at the pair's slot in `within`
+  Real* df_grad = nullptr;        // DFSPH: W'(r)/r of each pair of the rows (grad W = x_ij times it), at the
+                                  // pair's slot in `within`
 
   // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +
   // 1]. The rows cut to h (filter_rows): within + offsets[i], within_count[i] long; the pair passes read

@@ -90,6 +90,36 @@ struct BasicParticles {
 template <int Dim, class Real>
 using Particles = BasicParticles<Dim, Real, HostArray>;
 
+// Per-particle solver state that a step carries over to the next but that no output shows: a checkpoint
+// holds it after the particle fields (io/checkpoint.hpp), a reorder permutes it with the particles. Like
+// the particle fields, the list is for_each_field(); every field has one entry per particle (0 where the
+// model keeps no such state), in the particles' order.
+template <int Dim, class Real>
+struct SolverState {
+  // Model::Dfsph (models/dfsph.hpp): the divergence-free solve's accumulated pressure / rho^2, its next
+  // warm start. (The density solve's is p / rho^2, from particle fields.)
+  std::vector<Real> dfsph_kappa_v;
+
+  template <class Self, class F>
+  static void for_each_field(Self& self, F&& fn) {
+    fn(std::string_view("dfsph_kappa_v"), self.dfsph_kappa_v);
+  }
+  template <class F>
+  void for_each_field(F&& fn) {
+    for_each_field(*this, fn);
+  }
+  template <class F>
+  void for_each_field(F&& fn) const {
+    for_each_field(*this, fn);
+  }
+  // Every field n entries of 0.
+  void assign_zero(std::size_t n) {
+    for_each_field([n](std::string_view, auto& field) {
+      field.assign(n, typename std::remove_reference_t<decltype(field)>::value_type{});
+    });
+  }
+};
+
 // True when particle k has id k for every k (the order the outputs are written in).
 template <int Dim, class Real>
 bool in_id_order(const Particles<Dim, Real>& p) {

@@ -110,6 +110,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   complete(p_.id, "id", std::uint32_t{0});
   if (const auto err = id_permutation_error(p_.id); !err.empty()) throw InputError("particles: " + err);
   rho0_.assign(n, Real(0));
+  state_.assign_zero(n);
 
   fluid_count_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -195,7 +196,7 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.drho = drho_.data();
   v.df_alpha = df_alpha_.data();
   v.df_kappa = df_kappa_.data();
-  v.df_kappa_v = df_kappa_v_.data();
+  v.df_kappa_v = state_.dfsph_kappa_v.data();
   v.df_grad = df_grad_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
@@ -265,7 +266,7 @@ void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
   permute(prho2_);
   permute(f_pressure_);
   permute(normal_);
-  permute(df_kappa_v_);
+  state_.for_each_field([&](std::string_view, auto& field) { permute(field); });
   lists_valid_ = false;  // x_built_ and the lists name the old slots
 }
 
@@ -546,7 +547,6 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   prho2_.resize(n);
   df_alpha_.resize(n);
   df_kappa_.resize(n);
-  df_kappa_v_.resize(n, Real(0));
   df_grad_.resize(nl_.indices.size());
   if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
   const Real dt = dfsph_step(cfg_, view(), fluid_, df_diameter_, dfsph_stats_, steps_ + 1);
@@ -594,7 +594,7 @@ Real Simulation<Dim, Real>::total_mass() const {
 
 template <int Dim, class Real>
 void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state,
-                                    const std::string& source) {
+                                    const std::string& source, SolverState<Dim, Real> solver) {
   const std::size_t n = particles.size();
   if (n != p_.size()) {
     throw InputError(source + ": holds " + std::to_string(n) + " particles, the scene has " +
@@ -630,6 +630,18 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
         throw InputError(source + ": particle " + std::to_string(i) + " has a non-finite " +
                          std::string(name));
     }
+  });
+  // The solver state: one finite entry per particle, or none (0).
+  solver.for_each_field([&](std::string_view name, auto& field) {
+    using T = typename std::remove_cvref_t<decltype(field)>::value_type;
+    if (field.empty()) field.assign(n, T{});
+    if (field.size() != n)
+      throw InputError(source + ": holds " + std::to_string(field.size()) + " entries of the solver state '" +
+                       std::string(name) + "' for " + std::to_string(n) + " particles");
+    for (std::size_t i = 0; i < n; ++i)
+      if (!std::isfinite(field[i]))
+        throw InputError(source + ": particle " + std::to_string(i) + " has a non-finite " +
+                         std::string(name));
   });
   if (!(std::isfinite(state.time) && state.time >= 0 && std::isfinite(state.last_dt) && state.last_dt >= 0))
     throw InputError(source + ": simulated time " + std::to_string(state.time) + " / last step " +
@@ -673,7 +685,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   }
   fluid_count_ = fluid_.size();
   lists_valid_ = false;
-  df_kappa_v_.clear();
+  state_ = std::move(solver);
   // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
   // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
   // the file's fault, named as such (the Simulation is then not usable; the caller stops).

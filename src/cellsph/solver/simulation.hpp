@@ -110,9 +110,10 @@ class Simulation {
   [[nodiscard]] Real kinetic_energy() const;
   [[nodiscard]] Real total_mass() const;
 
-  // Checkpoints (written by io/simulation_checkpoint.hpp): the particles (every field of the field list)
-  // and this integrator state. Restoring both into a Simulation built from the same config and
-  // continuing gives results bit-identical to an uninterrupted run.
+  // Checkpoints (written by io/simulation_checkpoint.hpp): the particles (every field of the field list),
+  // the solver state (the same order) and this integrator state. Restoring the three into a Simulation
+  // built from the same config and continuing gives results bit-identical to an uninterrupted run.
+  [[nodiscard]] const SolverState<Dim, Real>& solver_state() const { return state_; }
   [[nodiscard]] IntegratorState<Real> integrator_state() const {
     return {time_, last_dt_, steps_, leapfrog_started_};
   }
@@ -122,8 +123,10 @@ class Simulation {
   // out of range, non-finite or negative time). The simulation is untouched on those errors; with dynamic
   // walls, positions beyond what the neighbour search indexes are found after the particles were
   // replaced (InputError too; the simulation must not be stepped then). The particles keep their
-  // order (a checkpoint holds the internal order, so a resume is bit for bit).
-  void restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state, const std::string& source);
+  // order (a checkpoint holds the internal order, so a resume is bit for bit). `solver`: the solver
+  // state, in the particles' order (its fields empty: 0, as for a run that starts).
+  void restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state, const std::string& source,
+               SolverState<Dim, Real> solver = {});
 
   // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
   // fluid particle in every sub-step, as before the work sets existed. Results are bit-identical either
@@ -240,11 +243,14 @@ class Simulation {
 
   StepTimings timings_;
 
-  // Model::Dfsph (models/dfsph.hpp): alpha and the sweep's k are rebuilt each step; the divergence
-  // solve's accumulated k is its next warm start (kept across steps, permuted by reorders; not in a
-  // checkpoint, so a resumed run restarts that warm start from 0).
-  std::vector<Real> df_alpha_, df_kappa_, df_kappa_v_;
-  std::vector<V> df_grad_;  // per pair slot of the rows (nl_.indices.size()): the step's kernel gradients
+  // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
+  // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.
+  SolverState<Dim, Real> state_;
+  // Model::Dfsph (models/dfsph.hpp): alpha and the sweep's k are rebuilt each step.
+  std::vector<Real> df_alpha_, df_kappa_;
+  // Per pair slot of the rows (nl_.indices.size()): the step's kernel gradients as W'(r)/r (one scalar,
+  // not the vector: a third of the bytes in 3D; the vector is x_ij times it).
+  std::vector<Real> df_grad_;
   Real df_diameter_ = 0;
   DfsphStats dfsph_stats_;
 };

@@ -58,15 +58,23 @@ struct DfsphStats {
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
 };
 
+// The step's kernel gradient of the pair at row slot `it` of i: x_ij times the scalar the density pass
+// stored (df_grad; positions do not change during the solves, and x_ij * gradW_factor has gradW's bits).
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> dfsph_grad(const ParticleView<Dim, Real>& pv, const Vec<Dim, Real>& xi,
+                                            const std::uint32_t* it) {
+  return (xi - pv.x[*it]) * pv.df_grad[it - pv.within];
+}
+
 // D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, at rest), over i's rows, with the step's
-// gradients (df_grad, written by the density pass).
+// gradients.
 template <int Dim, class Real>
 CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i) {
-  const Vec<Dim, Real> vi = pv.v[i];
+  const Vec<Dim, Real> xi = pv.x[i], vi = pv.v[i];
   Real d = 0;
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
     const std::uint32_t j = *it;
-    d += continuity_term(pv.df_grad[it - pv.within], pv.m[j], pv.is_fluid(j) ? vi - pv.v[j] : vi);
+    d += continuity_term(dfsph_grad(pv, xi, it), pv.m[j], pv.is_fluid(j) ? vi - pv.v[j] : vi);
   }
   return d;
 }
@@ -91,8 +99,9 @@ struct DfsphDensityFactorPass {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
       rho += density_term(w, pv.m[j], norm2(xij));
-      const V g = w.gradW(xij);
-      pv.df_grad[it - pv.within] = g;  // the step's gradients, read by every sweep (positions fixed)
+      const Real gs = w.gradW_factor(xij);
+      pv.df_grad[it - pv.within] = gs;  // the step's gradients, read by every sweep (positions fixed)
+      const V g = xij * gs;             // = w.gradW(xij), bit for bit
       const V mg = g * pv.m[j];
       grad += mg;
       if (pv.is_fluid(j)) sq += norm2(mg);
@@ -149,10 +158,11 @@ struct DfsphPressureKickPass {
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
     const Real mi = pv.m[i], ki = pv.df_kappa[i];
+    const V xi = pv.x[i];
     V f{};
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
-      f += symmetric_pressure_force(pv.df_grad[it - pv.within], mi, pv.m[j], ki,
+      f += symmetric_pressure_force(dfsph_grad(pv, xi, it), mi, pv.m[j], ki,
                                     pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
     }
     pv.v[i] += f * (dt / mi);
@@ -178,7 +188,7 @@ struct DfsphNonPressurePass {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
       const Real r = norm(xij);
-      const V g = pv.df_grad[it - pv.within];
+      const V g = xij * pv.df_grad[it - pv.within];
       if (pv.is_fluid(j))
         f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
       else if (no_slip)
