@@ -59,6 +59,8 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
   if (cfg.wall_model == WallModel::Dynamic)
     return "dynamic walls do not run on a device (boundary.model = akinci or adami)";
+  if (cfg.wall_motion.any())
+    return "moving walls (boundary.obstacles[].motion) do not run on a device yet (use --backend cpu)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
   if (cfg.density_evolution == DensityEvolution::Continuity)
     return "the continuity density does not run on a device yet (solver.density = summation)";
