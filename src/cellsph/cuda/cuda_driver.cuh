@@ -1,5 +1,5 @@
 #pragma once
-// The CUDA pass driver: the overloads of run_pass, reduce_max and first_where for CUDA index sets
+// The CUDA pass driver: the overloads of run_pass, reduce_max, reduce_sum and first_where for CUDA index sets
 // (solver/device/device_driver.hpp declares the sets; the CPU driver is solver/pass_driver.hpp), and
 // DeviceOps<CudaSpace> (CUB's radix sort and scan). Each pass is the CPU's functor, copied by value into
 // the kernel (a pass holds a ParticleView of device pointers and plain parameters). Seen only by nvcc.
@@ -73,6 +73,29 @@ __global__ void __launch_bounds__(kBlock)
   if (threadIdx.x == 0) out[blockIdx.x] = b;
 }
 
+// values[k] = pass(idx[k]) in double: the pass's side effects and values at full occupancy.
+template <class Pass>
+__global__ void __launch_bounds__(kBlock)
+    value_kernel(const std::uint32_t* idx, std::size_t n, Pass pass, double* values) {
+  const std::size_t stride = std::size_t{gridDim.x} * blockDim.x;
+  for (std::size_t k = std::size_t{blockIdx.x} * blockDim.x + threadIdx.x; k < n; k += stride)
+    values[k] = static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
+}
+
+// partial[b] = values[b kSumBlock] + ... in index order, one thread per block of kSumBlock: the CPU's
+// order (pass_driver.hpp reduce_sum_n), so the sum has the CPU's bits. A template (T = double) so that the
+// header can be included by several .cu files without defining the kernel twice.
+template <class T>
+__global__ void __launch_bounds__(kBlock)
+    block_sum_kernel(const T* values, std::size_t n, T* partial, std::size_t blocks) {
+  const std::size_t b = std::size_t{blockIdx.x} * blockDim.x + threadIdx.x;
+  if (b >= blocks) return;
+  const std::size_t begin = b * kSumBlock, end = begin + kSumBlock < n ? begin + kSumBlock : n;
+  T s = 0;
+  for (std::size_t k = begin; k < end; ++k) s += values[k];
+  partial[b] = s;
+}
+
 template <class Pred>
 __global__ void __launch_bounds__(kBlock)
     first_kernel(const std::uint32_t* idx, std::size_t n, Pred pred, unsigned long long* first) {
@@ -113,6 +136,27 @@ Result reduce_max(const DeviceIndexSet<CudaSpace>& set, Result init, const Pass&
   Result r = init;
   for (const Result& q : host) r = Result::max_of(r, q);
   return r;
+}
+
+// The CPU's sum, bit for bit: the values, the fixed blocks summed in order on the device, the block sums
+// added in order on the host.
+template <class Pass>
+double reduce_sum(const DeviceIndexSet<CudaSpace>& set, const Pass& pass) {
+  if (set.size == 0) return 0;
+  DeviceArray<double, CudaSpace> values(set.size);
+  cuda_detail::value_kernel<<<cuda_detail::blocks_for(set.size), cuda_detail::kBlock>>>(set.data, set.size,
+                                                                                        pass, values.data());
+  cuda_detail::check_launch("value_kernel<<<>>>");
+  const std::size_t blocks = (set.size + kSumBlock - 1) / kSumBlock;
+  DeviceArray<double, CudaSpace> partial(blocks);
+  cuda_detail::block_sum_kernel<double><<<cuda_detail::blocks_for(blocks), cuda_detail::kBlock>>>(
+      values.data(), set.size, partial.data(), blocks);
+  cuda_detail::check_launch("block_sum_kernel<<<>>>");
+  std::vector<double> host(blocks);
+  partial.download(host.data());
+  double s = 0;
+  for (const double q : host) s += q;
+  return s;
 }
 
 // Deterministic: the minimum failing index.

@@ -10,6 +10,7 @@ namespace cellsph {
 std::optional<ProbeKind> parse_probe_kind(std::string_view s) {
   if (s == "pressure") return ProbeKind::Pressure;
   if (s == "level") return ProbeKind::Level;
+  if (s == "layer") return ProbeKind::Layer;
   if (s == "velocity") return ProbeKind::Velocity;
   return std::nullopt;
 }
@@ -20,6 +21,8 @@ std::string_view probe_kind_name(ProbeKind k) {
       return "pressure";
     case ProbeKind::Level:
       return "level";
+    case ProbeKind::Layer:
+      return "layer";
     case ProbeKind::Velocity:
       break;
   }
@@ -78,10 +81,13 @@ void shepard(const Particles<Dim, Real>& p, const K& W, const std::array<double,
   for (int c = 0; c < count; ++c) out[c] = norm > 0 ? sum[c] / norm : kNaN;
 }
 
-// The level probe: phi(y) on the vertical line through `at`, from the fluid in its column.
+// The level and layer probes: phi(y) on the vertical line through `at`, from the fluid in its column.
+// level: the highest crossing of 1/2 (searched from the top down); layer: the first crossing from 1/2 or
+// more to below it going up from `at`, where phi must reach 1/2 within one support of `at` (the water
+// stands on `at`); water above a dry gap, a jet or spray in the air over the gauge, is not counted.
 template <int Dim, class Real, class K>
 double level(const Particles<Dim, Real>& p, const K& W, const std::array<double, 3>& at, double h,
-             double spacing) {
+             double spacing, bool layer) {
   constexpr int up = Dim - 1;
   std::vector<std::pair<std::array<double, 3>, double>> column;  // position, volume
   double top = -std::numeric_limits<double>::infinity();
@@ -106,10 +112,30 @@ double level(const Particles<Dim, Real>& p, const K& W, const std::array<double,
     }
     return s;
   };
-  // From the top of the column down to `at`: the first sample at or above 1/2 ends the search.
   const double step = spacing / 4;
   const double start = top + h;
   if (start <= at[up]) return 0;
+  if (layer) {
+    // From `at` up: wet within one support of it, then the first sample below 1/2 ends the search.
+    const auto samples = static_cast<long>(std::ceil((start - at[up]) / step));
+    bool wet = false;
+    double y_below = at[up], phi_below = 0;
+    for (long s = 0; s <= samples; ++s) {
+      const double y = at[up] + double(s) * step;
+      const double f = phi(y);
+      if (!wet) {
+        if (y > at[up] + h) return 0;
+        wet = f >= 0.5;
+      } else if (f < 0.5) {
+        const double t = (phi_below - 0.5) / (phi_below - f);  // f < 1/2 <= phi_below
+        return y_below + t * step - at[up];
+      }
+      y_below = y;
+      phi_below = f;
+    }
+    return 0;
+  }
+  // From the top of the column down to `at`: the first sample at or above 1/2 ends the search.
   const auto samples = static_cast<long>(std::ceil((start - at[up]) / step));
   double y_above = start, phi_above = phi(start);
   for (long s = 1; s <= samples; ++s) {
@@ -149,7 +175,8 @@ std::vector<double> ProbeSampler<Dim, Real>::sample(const Particles<Dim, Real>& 
           out.insert(out.end(), v, v + Dim);
           break;
         case ProbeKind::Level:
-          out.push_back(level(p, W, pr.at, h_, spacing_));
+        case ProbeKind::Layer:
+          out.push_back(level(p, W, pr.at, h_, spacing_, pr.kind == ProbeKind::Layer));
           break;
       }
     }

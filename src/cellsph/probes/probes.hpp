@@ -11,6 +11,10 @@
 //             surface, so the level is the highest height at which phi crosses 1/2 (linearly
 //             interpolated between samples a quarter spacing apart), minus the height of `at`; 0 when
 //             phi stays below 1/2 (dry, or a film thinner than about h/2).
+//   layer     the depth of the water standing on `at`: going up from `at`, phi must reach 1/2 within
+//             one support (else 0: dry), and the layer ends at the first height where it falls below
+//             1/2 again (interpolated the same way). Water above a dry gap (a jet or spray in the air
+//             over the gauge) counts for `level`, not for `layer`.
 //
 // The sums are brute force over the fluid particles near the probe (a column of width 2h for a level),
 // so a sample costs O(n) per probe: meant for a sample every many steps, not every step.
@@ -26,7 +30,7 @@
 
 namespace cellsph {
 
-enum class ProbeKind { Pressure, Level, Velocity };
+enum class ProbeKind { Pressure, Level, Velocity, Layer };
 
 std::optional<ProbeKind> parse_probe_kind(std::string_view s);
 std::string_view probe_kind_name(ProbeKind k);

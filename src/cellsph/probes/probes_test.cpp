@@ -98,8 +98,35 @@ TEST(Probes, LevelIsMeasuredFromTheProbesFoot) {
   EXPECT_NEAR(sampler.sample(p)[0], 0.2, 0.25 * s);
 }
 
+// Water in the air over a gauge (a block 0.1 m deep, and a blob 0.1 m thick from 0.3 to 0.4 m above a dry
+// gap, as a plunging jet passes over a gauge): `level` reads the blob's top, `layer` the water standing
+// on the floor; both read the same over the block alone, and a blob over a dry floor is dry for `layer`.
+TEST(Probes, LayerIgnoresWaterAboveADryGap) {
+  const double s = 0.02;
+  Particles<2, double> p;
+  add_block<2, double>(p, {{0, 0}}, {{0.4, 0.1}}, s, 0, kRho0 * s * s);
+  add_block<2, double>(p, {{0, 0.3}}, {{0.2, 0.4}}, s, 0, kRho0 * s * s);
+  for (std::size_t j = 0; j < p.size(); ++j) p.rho[j] = kRho0;
+  const ProbeSampler<2, double> sampler({{"level", ProbeKind::Level, {0.1, 0, 0}},
+                                         {"layer", ProbeKind::Layer, {0.1, 0, 0}},
+                                         {"level_clear", ProbeKind::Level, {0.3, 0, 0}},
+                                         {"layer_clear", ProbeKind::Layer, {0.3, 0, 0}}},
+                                        KernelKind::CubicSpline, 2 * s, s);
+  const auto v = sampler.sample(p);
+  EXPECT_NEAR(v[0], 0.4, 0.25 * s);
+  EXPECT_NEAR(v[1], 0.1, 0.25 * s);
+  EXPECT_NEAR(v[2], 0.1, 0.25 * s);
+  EXPECT_NEAR(v[3], v[2], 1e-3 * s);
+  Particles<2, double> blob;  // the blob alone, over a dry floor
+  add_block<2, double>(blob, {{0, 0.3}}, {{0.2, 0.4}}, s, 0, kRho0 * s * s);
+  for (std::size_t j = 0; j < blob.size(); ++j) blob.rho[j] = kRho0;
+  const auto d = sampler.sample(blob);
+  EXPECT_NEAR(d[0], 0.4, 0.25 * s);
+  EXPECT_EQ(d[1], 0.0);
+}
+
 TEST(Probes, KindNames) {
-  for (ProbeKind k : {ProbeKind::Pressure, ProbeKind::Level, ProbeKind::Velocity})
+  for (ProbeKind k : {ProbeKind::Pressure, ProbeKind::Level, ProbeKind::Velocity, ProbeKind::Layer})
     EXPECT_EQ(parse_probe_kind(probe_kind_name(k)), k);
   EXPECT_FALSE(parse_probe_kind("height"));
 }

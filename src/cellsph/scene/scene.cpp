@@ -1204,8 +1204,8 @@ void read_probes(JsonReader& r, std::vector<Probe>& probes, double& every) {
     for (const auto& c : probe_columns({pr}, Dim))
       for (const auto& t : taken)
         if (c == t) e.fail("name", "'" + pr.name + "' gives the column '" + c + "', which is already taken");
-    if (!e.has("kind")) e.fail("kind", "required: pressure, level or velocity");
-    pr.kind = *parse_probe_kind(e.choice("kind", "pressure", {"pressure", "level", "velocity"}));
+    if (!e.has("kind")) e.fail("kind", "required: pressure, level, layer or velocity");
+    pr.kind = *parse_probe_kind(e.choice("kind", "pressure", {"pressure", "level", "layer", "velocity"}));
     const auto at = e.required_vector("at", Dim);
     for (std::size_t a = 0; a < Dim; ++a) pr.at[a] = at[a];
     e.finish();

@@ -115,6 +115,16 @@ double energy(const Simulation<Dim, Real>& sim) {
   return e;
 }
 
+// The up axis: the one gravity points against (its largest component; y without gravity). Every scene
+// has y up except spheric-test2 (z up, as its data file).
+template <int Dim, class Real>
+int up_axis(const Simulation<Dim, Real>& sim) {
+  int up = 1;
+  for (int a = 0; a < Dim; ++a)
+    if (std::abs(double(sim.config().gravity[a])) > std::abs(double(sim.config().gravity[up]))) up = a;
+  return up;
+}
+
 // The region the fluid must stay in: the box, the walls (open top: no upper bound upwards), the planes.
 template <int Dim, class Real>
 void check_inside(const Simulation<Dim, Real>& sim, const nlohmann::json& j, const std::string& name,
@@ -132,8 +142,8 @@ void check_inside(const Simulation<Dim, Real>& sim, const nlohmann::json& j, con
       lo[a] = r["min"][a].get<double>();
       hi[a] = r["max"][a].get<double>();
     }
-    if (walls && b["walls"].value("open_top", true)) hi[1] = 1e300;  // every scene has y up
-  } else if (j.contains("domain")) {                                 // free droplet: its domain
+    if (walls && b["walls"].value("open_top", true)) hi[static_cast<std::size_t>(up_axis(sim))] = 1e300;
+  } else if (j.contains("domain")) {  // free droplet: its domain
     for (int a = 0; a < Dim; ++a) {
       lo[a] = j["domain"]["min"][a].get<double>();
       hi[a] = j["domain"]["max"][a].get<double>();
@@ -179,7 +189,7 @@ void run_scene(const nlohmann::json& j, const std::string& name, bool energy_bou
   for (int a = 0; a < Dim; ++a) g += double(scene.solver.gravity[a]) * double(scene.solver.gravity[a]);
   g = std::sqrt(g);
   double ylo = 1e300, yhi = -1e300;
-  const int up = 1;
+  const int up = up_axis(sim);
   const auto& q = sim.particles();
   for (std::size_t i = 0; i < q.size(); ++i)
     if (q.kind[i] == 0) {

@@ -87,4 +87,25 @@ struct ParticleView {
   }
 };
 
+// Points the view's particle fields at a particle storage's arrays: Particles on the host or
+// DeviceParticles in a device memory space (any BasicParticles, particles.hpp), so the field-by-field
+// wiring is written once for both backends. The count and the solver's own arrays are the caller's.
+template <int Dim, class Real, class Storage>
+void attach_particle_fields(ParticleView<Dim, Real>& v, Storage& s) {
+  v.x = s.x.data();
+  v.v = s.v.data();
+  v.f = s.f.data();
+  v.m = s.m.data();
+  v.rho = s.rho.data();
+  v.p = s.p.data();
+  v.h = s.h.data();
+  v.color = s.color.data();
+  v.mu = s.mu.data();
+  v.phase = s.phase.data();
+  v.level = s.level.data();
+  v.tick = s.tick.data();
+  v.kind = s.kind.data();
+  v.id = s.id.data();
+}
+
 }  // namespace cellsph

@@ -52,26 +52,31 @@ Result reduce_max_n(const std::uint32_t* idx, std::size_t n, Result init, const 
   return r;
 }
 
-// The sum of pass(i) over `set`, in double, independent of the thread count: the set is cut into fixed
-// blocks of 1024 entries, each summed in order, and the block sums are added in order (a plain
-// per-thread partial sum would change in the last bits with the thread count).
+// The sum of pass(idx[k]) for k < n, in double, independent of the thread count: the entries are cut into
+// fixed blocks of kSumBlock, each summed in order, and the block sums are added in order (a plain
+// per-thread partial sum would change in the last bits with the thread count). The CUDA driver
+// (cuda/cuda_driver.cuh) adds in the same order, so a device gives the same bits.
+inline constexpr std::size_t kSumBlock = 1024;
+
 template <class Pass>
-double reduce_sum(const IndexSet& set, const Pass& pass) {
-  constexpr std::size_t kBlock = 1024;
-  const std::size_t blocks = (set.size() + kBlock - 1) / kBlock;
+double reduce_sum_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
+  const std::size_t blocks = (n + kSumBlock - 1) / kSumBlock;
   std::vector<double> partial(blocks, 0.0);
-  const std::uint32_t* idx = set.data();
-  const std::size_t n = set.size();
   parallel_for(blocks, [&](std::size_t b) {
     double s = 0;
-    const std::size_t end = std::min(n, (b + 1) * kBlock);
-    for (std::size_t k = b * kBlock; k < end; ++k)
+    const std::size_t end = std::min(n, (b + 1) * kSumBlock);
+    for (std::size_t k = b * kSumBlock; k < end; ++k)
       s += static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
     partial[b] = s;
   });
   double s = 0;
   for (const double q : partial) s += q;
   return s;
+}
+
+template <class Pass>
+double reduce_sum(const IndexSet& set, const Pass& pass) {
+  return reduce_sum_n(set.data(), set.size(), pass);
 }
 
 // The lowest index idx[k] with pred(idx[k]) true, or -1 if none (deterministic: a minimum).

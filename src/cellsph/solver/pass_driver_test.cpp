@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -107,6 +108,38 @@ struct Line {
     return v;
   }
 };
+
+// The documented order (blocks of kSumBlock summed in order, then the block sums in order), written out as a
+// plain loop; the same bits for every thread count, and the exact sum within rounding.
+TEST(PassDriver, ReduceSumAddsInFixedBlocksWhateverTheThreadCount) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> value(5000);
+  for (double& v : value) v = u(rng) * std::pow(10.0, static_cast<int>(rng() % 9) - 4);
+  const IndexSet set = random_set(rng, 5000);  // about 3300 entries: four blocks, the last partial
+  auto pass = [&](std::size_t i) { return value[i]; };
+  double want = 0;
+  long double exact = 0, magnitude = 0;
+  for (std::size_t b = 0; b * kSumBlock < set.size(); ++b) {
+    double block = 0;
+    for (std::size_t k = b * kSumBlock; k < std::min(set.size(), (b + 1) * kSumBlock); ++k)
+      block += value[set[k]];
+    want += block;
+  }
+  for (const std::uint32_t i : set) {
+    exact += value[i];
+    magnitude += std::abs(value[i]);
+  }
+  // Recursive summation's bound: (n - 1) eps sum |v|.
+  const double bound = static_cast<double>(set.size()) * 1.2e-16 * static_cast<double>(magnitude);
+  for (const int threads : {1, 2, 3}) {
+    ScopedThreads st(threads);
+    const double got = reduce_sum(set, pass);
+    EXPECT_EQ(got, want) << threads << " threads";
+    EXPECT_NEAR(got, static_cast<double>(exact), bound);
+  }
+  EXPECT_EQ(reduce_sum(IndexSet{}, pass), 0.0);
+}
 
 TEST(Passes, FilterRowsAndSummationDensityOnAHandMadeView) {
   Line l;

@@ -229,20 +229,7 @@ template <int Dim, class Real>
 ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   ParticleView<Dim, Real> v;
   v.n = p_.size();
-  v.x = p_.x.data();
-  v.v = p_.v.data();
-  v.f = p_.f.data();
-  v.m = p_.m.data();
-  v.rho = p_.rho.data();
-  v.p = p_.p.data();
-  v.h = p_.h.data();
-  v.color = p_.color.data();
-  v.mu = p_.mu.data();
-  v.phase = p_.phase.data();
-  v.level = p_.level.data();
-  v.tick = p_.tick.data();
-  v.kind = p_.kind.data();
-  v.id = p_.id.data();
+  attach_particle_fields(v, p_);
   v.rho0 = rho0_.data();
   v.vol = vol_.data();
   v.prho2 = prho2_.data();
@@ -756,7 +743,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   leapfrog_started_ = state.leapfrog_started;
   move_walls(time_);
   if (device_) {
-    device_->upload(p_);
+    upload_to_device();
     host_stale_ = false;
   }
 }
@@ -776,15 +763,24 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
     throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
   sync_host();
   device_ = b == Backend::Cuda ? make_cuda_stepper(cfg_) : make_host_device_stepper(cfg_);
-  device_->upload(p_);
+  upload_to_device();
   backend_ = b;
 }
 
-// One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH
-// with global steps, on the device's copy of the particles.
+// The particles and, for dynamic walls, their fixed wall-wall densities (init_boundary_weights).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::upload_to_device() {
+  device_->upload(p_);
+  if (cfg_.wall_model == WallModel::Dynamic && !boundary_.empty())
+    device_->upload_wall_self_density(wall_self_rho_);
+}
+
+// One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH or
+// the paper's model with global steps, on the device's copy of the particles.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step_device() {
-  const DeviceStepResult<Real> r = device_->step();
+  const DeviceStepResult<Real> r = device_->step(last_dt_, leapfrog_started_);
+  if (cfg_.model == Model::PaperMultiphase) leapfrog_started_ = true;
   host_stale_ = true;
   timings_.neighbors += r.neighbors_ms;
   timings_.forces += r.forces_ms;

@@ -168,6 +168,7 @@ class Simulation {
   void check_state();
   [[noreturn]] void report_unstable(std::int64_t first) const;
   void step_device();
+  void upload_to_device();
   void sync_host() const;
   void init_boundary_weights();
   // Moving walls (boundary/wall_motion.hpp): the slots of the moving wall particles with their initial

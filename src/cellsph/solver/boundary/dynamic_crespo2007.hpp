@@ -71,9 +71,9 @@ void dynamic_wall_self_density(const SolverConfig<Dim, Real>& cfg, const Particl
 }
 
 // The states of the wall particles of `boundary`, after the density pass and gather_wall_neighbors.
-template <int Dim, class Real>
+template <int Dim, class Real, class Set>
 void dynamic_wall_states(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                         const IndexSet& boundary) {
+                         const Set& boundary) {
   with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
     run_pass(boundary, DynamicWallStatePass<Dim, Real, std::remove_cvref_t<decltype(w)>>{pv, w, cfg.eos});
   });

@@ -64,6 +64,23 @@ TEST(DeviceMemory, MirrorCopiesEveryFieldBothWays) {
 }
 
 // The grid's rows against all pairs: row i = every j != i with distance2 <= h_i^2, ascending.
+// The device's sum (DFSPH's average errors) has the CPU's bits.
+TEST(DeviceDriver, ReduceSumEqualsTheCpusBits) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> value(4000);
+  for (double& v : value) v = u(rng) * 1e-3 + (rng() % 7 == 0 ? 1e3 : 0.0);
+  std::vector<std::uint32_t> idx;
+  for (std::uint32_t i = 0; i < 4000; ++i)
+    if (rng() % 4 != 0) idx.push_back(i);
+  DeviceArray<std::uint32_t, HostDeviceSpace> dev_idx;
+  dev_idx.upload(idx.data(), idx.size());
+  auto pass = [&](std::size_t i) { return value[i]; };
+  const double cpu = reduce_sum(IndexSet(idx.begin(), idx.end()), pass);
+  EXPECT_EQ(reduce_sum(DeviceIndexSet<HostDeviceSpace>{dev_idx.data(), idx.size()}, pass), cpu);
+  EXPECT_GT(cpu, 0.0);
+}
+
 TEST(DeviceGrid, RowsEqualBruteForceIncludingWallRows) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
@@ -131,6 +148,28 @@ TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu2D) {
   expect_same_steps(box.cfg, box.particles, 30);
 }
 
+// The continuity density with Fourtakas's density diffusion (models/continuity_density.hpp): the kick, the
+// rate, the update and the drift on the device, and the density carried from step to step.
+TEST_P(DeviceWalls, HostDeviceContinuityWithDiffusionIsBitIdenticalToTheCpu2D) {
+  auto box = test::weakly_viscous_box(Model::Wcsph, GetParam(), 0.5);
+  box.cfg.density_evolution = DensityEvolution::Continuity;
+  box.cfg.density_diffusion.kind = DensityDiffusion::Fourtakas;
+  box.cfg.density_diffusion.delta = 0.1;
+  expect_same_steps(box.cfg, box.particles, 30);
+}
+
+// The paper's model (models/paper_multiphase.hpp): its forces with each tension model (the CSF and Akinci
+// ones through the colour normals) and its leap-frog.
+TEST_P(DeviceWalls, HostDevicePaperModelIsBitIdenticalToTheCpu2D) {
+  for (const auto tension : {TensionModel::Paper, TensionModel::Csf, TensionModel::Akinci}) {
+    auto box = test::weakly_viscous_box(Model::PaperMultiphase, GetParam(), 0.5);
+    box.cfg.phases[0].sigma = 0.05;
+    box.cfg.tension = tension;
+    SCOPED_TRACE(static_cast<int>(tension));
+    expect_same_steps(box.cfg, box.particles, 30);
+  }
+}
+
 TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu3DFloatWithBoxAndPlane) {
   const float s = 0.04f;
   SolverConfig<3, float> cfg;
@@ -158,7 +197,8 @@ TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu3DFloatWithBoxAndPlane
   expect_same_steps(cfg, p, 25);
 }
 
-INSTANTIATE_TEST_SUITE_P(Device, DeviceWalls, ::testing::Values(WallModel::Akinci, WallModel::Adami),
+INSTANTIATE_TEST_SUITE_P(Device, DeviceWalls,
+                         ::testing::Values(WallModel::Akinci, WallModel::Adami, WallModel::Dynamic),
                          [](const auto& p) { return std::string(wall_model_name(p.param)); });
 
 TEST(DeviceBackend, SameBitsForAnyThreadCount) {
@@ -193,8 +233,11 @@ TEST(DeviceBackend, StateStaysOnTheDeviceUntilAsked) {
 }
 
 // A checkpoint (particles + integrator state) taken on one backend resumes on the other, bit for bit.
-TEST(DeviceBackend, CheckpointsResumeAcrossBackends) {
-  auto box = test::weakly_viscous_box(Model::Wcsph, WallModel::Adami, 0.5);
+// The paper model's leap-frog carries its state (the last step, whether it has started) across too.
+class DeviceResume : public ::testing::TestWithParam<Model> {};
+
+TEST_P(DeviceResume, CheckpointsResumeAcrossBackends) {
+  auto box = test::weakly_viscous_box(GetParam(), WallModel::Adami, 0.5);
   Simulation<2, double> whole(box.cfg, box.particles);
   for (int s = 0; s < 30; ++s) whole.step();
   for (const bool device_first : {true, false}) {
@@ -216,6 +259,9 @@ TEST(DeviceBackend, CheckpointsResumeAcrossBackends) {
   for (int s = 0; s < 15; ++s) mixed.step();
   EXPECT_TRUE(same_state(whole.particles(), mixed.particles()));
 }
+
+INSTANTIATE_TEST_SUITE_P(Device, DeviceResume, ::testing::Values(Model::Wcsph, Model::PaperMultiphase),
+                         [](const auto& p) { return std::string(model_name(p.param)); });
 
 TEST(DeviceBackend, UnstableRunGivesTheCpuDiagnosis) {
   auto box = test::weakly_viscous_box(Model::Wcsph, WallModel::Akinci, 0.5);
@@ -251,9 +297,9 @@ TEST(DeviceBackend, UnsupportedConfigsAreInputErrors) {
     sim.step();  // still usable on the CPU
   };
   auto cfg = test::wcsph_water(0.02, 10);
-  auto paper = cfg;
-  paper.model = Model::PaperMultiphase;
-  expect_refused(paper, "only the WCSPH model");
+  auto dfsph = cfg;
+  dfsph.model = Model::Dfsph;
+  expect_refused(dfsph, "DFSPH does not run on a device");
   auto reorder = cfg;
   reorder.reorder_every = 10;
   expect_refused(reorder, "neighbors.reorder_every");

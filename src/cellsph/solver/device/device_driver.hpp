@@ -1,6 +1,7 @@
 #pragma once
 // The pass driver of the device backends (pass_driver.hpp is the CPU's). A device index set names
-// indices held in the space's memory; run_pass, reduce_max and first_where are overloaded for it, so the
+// indices held in the space's memory; run_pass, reduce_max, reduce_sum and first_where are overloaded for it,
+// so the
 // model files' functions (templated on the set type) run their passes on a device unchanged. Besides the
 // passes, a device step needs three primitives, in DeviceOps<Space>: a stable sort of (key, index) pairs
 // on the low key bits, an exclusive scan of counts, and a synchronisation point.
@@ -51,6 +52,11 @@ void run_pass(const DeviceRange<HostDeviceSpace>& range, const Pass& pass) {
 template <class Result, class Pass>
 Result reduce_max(const DeviceIndexSet<HostDeviceSpace>& set, Result init, const Pass& pass) {
   return reduce_max_n(set.data, set.size, init, pass);
+}
+
+template <class Pass>
+double reduce_sum(const DeviceIndexSet<HostDeviceSpace>& set, const Pass& pass) {
+  return reduce_sum_n(set.data, set.size, pass);
 }
 
 template <class Pred>

@@ -17,12 +17,15 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/solver/boundary/adami2012.hpp"
+#include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_driver.hpp"
 #include "cellsph/solver/device/device_grid.hpp"
 #include "cellsph/solver/device/device_stepper_base.hpp"
 #include "cellsph/solver/device/memory_space.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
+#include "cellsph/solver/models/continuity_density.hpp"
+#include "cellsph/solver/models/paper_multiphase.hpp"
 #include "cellsph/solver/models/summation_density.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
 #include "cellsph/solver/particle_view.hpp"
@@ -66,7 +69,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     boundary_.upload(boundary.data(), boundary.size());
     rho0_.upload(rho0.data(), n_);
     wall_states_ = cfg_.wall_model != WallModel::Akinci && !boundary.empty();
-    for (auto* a : {&vol_, &prho2_}) {
+    for (auto* a : {&vol_, &prho2_, &drho_}) {
       a->resize(n_);
       a->zero();
     }
@@ -76,9 +79,14 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     }
   }
 
+  void upload_wall_self_density(const std::vector<Real>& rho) override {
+    CELLSPH_CHECK(rho.size() == n_, "one wall-wall density per particle");
+    wall_self_rho_.upload(rho.data(), n_);
+  }
+
   void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
 
-  DeviceStepResult<Real> step() override {
+  DeviceStepResult<Real> step(Real last_dt, bool leapfrog_started) override {
     DeviceStepResult<Real> r;
     Stopwatch sw;
     build_rows();
@@ -89,15 +97,29 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     const auto pv = view();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
     const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
-    summation_density(cfg_, pv, fluid);
-    if (wall_states_) adami2012_wall_states(cfg_, pv, boundary);
-    wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
+    if (continuity())
+      continuity_state(cfg_, pv, fluid);
+    else
+      summation_density(cfg_, pv, fluid);
+    if (wall_states_ && cfg_.wall_model == WallModel::Dynamic)
+      dynamic_wall_states(cfg_, pv, boundary);
+    else if (wall_states_)
+      adami2012_wall_states(cfg_, pv, boundary);
+    if (paper())
+      forces_paper(pv, fluid);
+    else
+      wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
     Ops::synchronize();
     r.forces_ms = sw.ms();
 
     sw.reset();
     r.dt = global_courant_dt(cfg_, pv, fluid);
-    run_pass(fluid, WcsphSymplecticEulerPass<Dim, Real>{pv, r.dt});
+    if (paper()) {
+      const Real kick = leapfrog_started ? (last_dt + r.dt) / 2 : r.dt / 2;  // Simulation::integrate_paper
+      run_pass(fluid, PaperLeapFrogPass<Dim, Real>{pv, kick, r.dt});
+    } else {
+      integrate(pv, fluid, r.dt);
+    }
     if (cfg_.box.enabled || !cfg_.planes.empty()) {
       auto walls = box_plane_collisions(cfg_, pv);
       walls.planes = planes_.data();  // the device's copy of cfg.planes
@@ -130,25 +152,14 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   ParticleView<Dim, Real> view() {
     ParticleView<Dim, Real> v;
     v.n = n_;
-    v.x = d_.x.data();
-    v.v = d_.v.data();
-    v.f = d_.f.data();
-    v.m = d_.m.data();
-    v.rho = d_.rho.data();
-    v.p = d_.p.data();
-    v.h = d_.h.data();
-    v.color = d_.color.data();
-    v.mu = d_.mu.data();
-    v.phase = d_.phase.data();
-    v.level = d_.level.data();
-    v.tick = d_.tick.data();
-    v.kind = d_.kind.data();
-    v.id = d_.id.data();
+    attach_particle_fields(v, d_);
     v.rho0 = rho0_.data();
     v.vol = vol_.data();
     v.prho2 = prho2_.data();
     v.f_pressure = f_pressure_.data();
     v.wall_v = wall_v_.data();
+    v.drho = drho_.data();
+    v.wall_self_rho = wall_self_rho_.data();
     v.offsets = offsets_.data();
     v.candidates = rows_.data();
     v.within = rows_.data();
@@ -157,6 +168,39 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.wall_nbr = wall_rows_.data();
     v.phases = phases_.data();
     return v;
+  }
+
+  bool paper() const { return cfg_.model == Model::PaperMultiphase; }
+
+  // Simulation::compute_forces_paper: the colour normals (every particle's cleared first) when the tension
+  // model needs them, then the forces (models/paper_multiphase.hpp).
+  void forces_paper(const ParticleView<Dim, Real>& pv, const DeviceIndexSet<Space>& fluid) {
+    const auto tension = PaperTension::of(cfg_, any_tension_);
+    if (tension.needs_normals()) {
+      normal_.resize(n_);
+      normal_.zero();
+      auto with_normals = pv;
+      with_normals.normal = normal_.data();
+      paper_normals(cfg_, with_normals, fluid);
+      paper_forces(cfg_, with_normals, fluid, tension, wall_states_);
+      return;
+    }
+    paper_forces(cfg_, pv, fluid, tension, wall_states_);
+  }
+
+  bool continuity() const { return cfg_.density_evolution == DensityEvolution::Continuity; }
+
+  // Simulation::integrate_wcsph's sequence: symplectic Euler, or with the continuity density the kick, the
+  // density rate at the old positions, the density update and the drift (models/continuity_density.hpp).
+  void integrate(const ParticleView<Dim, Real>& pv, const DeviceIndexSet<Space>& fluid, Real dt) {
+    if (!continuity()) {
+      run_pass(fluid, WcsphSymplecticEulerPass<Dim, Real>{pv, dt});
+      return;
+    }
+    run_pass(fluid, WcsphKickPass<Dim, Real>{pv, dt});
+    continuity_rate(cfg_, pv, fluid);
+    run_pass(fluid, ContinuityIntegratePass<Dim, Real>{pv, dt});
+    run_pass(fluid, WcsphDriftPass<Dim, Real>{pv, dt});
   }
 
   // The sorted grid (device_grid.hpp) and the rows of the fluid (and, for wall states, of the walls).
@@ -197,54 +241,37 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     run_pass(DeviceRange<Space>{ncells}, ClearCellsPass{cell_start_.data()});
     run_pass(all, CellBoundsPass{sorted_key_.data(), n_, cell_start_.data(), cell_end_.data()});
 
-    // Fluid rows: count, scan into offsets, fill (and sort).
-    count_.resize(n_ + 1);
-    count_.zero();
-    offsets_.resize(n_ + 1);
-    const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
-    GridRowPass<Dim, Real, std::uint64_t> rp{g,
-                                             d_.x.data(),
-                                             d_.h.data(),
-                                             d_.kind.data(),
-                                             xs_.data(),
-                                             sorted_idx_.data(),
-                                             cell_start_.data(),
-                                             cell_end_.data(),
-                                             false,
-                                             count_.data(),
-                                             nullptr,
-                                             nullptr};
-    run_pass(fluid, rp);
-    Ops::exclusive_scan(count_.data(), offsets_.data(), n_, scratch_);
-    rows_.resize(static_cast<std::size_t>(offsets_.get(n_)));
-    rp.offsets = offsets_.data();
-    rp.rows = rows_.data();
-    run_pass(fluid, rp);
+    // Fluid rows (all neighbours) and, for wall states, the wall rows (each wall's fluid neighbours).
+    fill_rows(g, fluid_, false, count_, offsets_, rows_);
+    if (wall_states_) fill_rows(g, boundary_, true, wall_count_, wall_start_, wall_rows_);
+  }
 
-    if (!wall_states_) return;
-    // Wall rows: the fluid neighbours of each wall particle.
-    wall_count_.resize(n_ + 1);
-    wall_count_.zero();
-    wall_start_.resize(n_ + 1);
-    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
-    GridRowPass<Dim, Real, std::uint32_t> wp{g,
-                                             d_.x.data(),
-                                             d_.h.data(),
-                                             d_.kind.data(),
-                                             xs_.data(),
-                                             sorted_idx_.data(),
-                                             cell_start_.data(),
-                                             cell_end_.data(),
-                                             true,
-                                             wall_count_.data(),
-                                             nullptr,
-                                             nullptr};
-    run_pass(boundary, wp);
-    Ops::exclusive_scan(wall_count_.data(), wall_start_.data(), n_, scratch_);
-    wall_rows_.resize(wall_start_.get(n_));
-    wp.offsets = wall_start_.data();
-    wp.rows = wall_rows_.data();
-    run_pass(boundary, wp);
+  // The rows of the particles in `set` over the grid `g`: count, exclusive scan into `offsets`, fill.
+  template <class Offset>
+  void fill_rows(const GridGeometry<Dim, Real>& g, const Array<std::uint32_t>& set, bool walls,
+                 Array<std::uint32_t>& count, Array<Offset>& offsets, Array<std::uint32_t>& rows) {
+    count.resize(n_ + 1);
+    count.zero();
+    offsets.resize(n_ + 1);
+    const DeviceIndexSet<Space> indices{set.data(), set.size()};
+    GridRowPass<Dim, Real, Offset> rp{g,
+                                      d_.x.data(),
+                                      d_.h.data(),
+                                      d_.kind.data(),
+                                      xs_.data(),
+                                      sorted_idx_.data(),
+                                      cell_start_.data(),
+                                      cell_end_.data(),
+                                      walls,
+                                      count.data(),
+                                      nullptr,
+                                      nullptr};
+    run_pass(indices, rp);
+    Ops::exclusive_scan(count.data(), offsets.data(), n_, scratch_);
+    rows.resize(static_cast<std::size_t>(offsets.get(n_)));
+    rp.offsets = offsets.data();
+    rp.rows = rows.data();
+    run_pass(indices, rp);
   }
 
   static constexpr std::size_t kMaxCells = std::size_t{1} << 30;
@@ -257,8 +284,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<PhaseParams<Real>> phases_;
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
-  Array<Real> rho0_, vol_, prho2_;
-  Array<V> f_pressure_, wall_v_;
+  Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
+  Array<V> f_pressure_, wall_v_, normal_;
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;
   Array<V> xs_;

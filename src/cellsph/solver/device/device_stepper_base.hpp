@@ -41,12 +41,16 @@ class DeviceStepperBase {
   // Every field of the field list (particles.hpp) to the device (the index sets and rest densities are
   // derived from them there).
   virtual void upload(const Particles<Dim, Real>& p) = 0;
+  // Dynamic walls: each wall particle's fixed wall-wall density (boundary/dynamic_crespo2007.hpp), which the
+  // Simulation computes once from rows the device does not build; after upload(), indexed like its particles.
+  virtual void upload_wall_self_density(const std::vector<Real>& rho) = 0;
   // Every field back into p (resized).
   virtual void download(Particles<Dim, Real>& p) = 0;
-  // One step of Simulation::step() for WCSPH with a global step: neighbour rows, density, wall states,
-  // forces, dt, symplectic Euler, box and planes, the stability check. Positions are left as computed
-  // even when the check fails (as on the CPU).
-  virtual DeviceStepResult<Real> step() = 0;
+  // One step of Simulation::step() with a global step: neighbour rows, density, wall states, forces (WCSPH
+  // or the paper's model), dt, integration (symplectic Euler or the paper's leap-frog, whose kick needs the
+  // last step and whether the leap-frog has started: the Simulation's state), box and planes, the
+  // stability check. Positions are left as computed even when the check fails (as on the CPU).
+  virtual DeviceStepResult<Real> step(Real last_dt, bool leapfrog_started) = 0;
   // The rows of the current positions (built afresh), copied to the host.
   virtual DeviceRows neighbor_rows() = 0;
 };
@@ -54,16 +58,12 @@ class DeviceStepperBase {
 // Empty when the device step runs this config; otherwise what it lacks, in one phrase.
 template <int Dim, class Real>
 std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
-  if (cfg.model != Model::Wcsph) return "only the WCSPH model runs on a device (solver.model = wcsph)";
+  if (cfg.model == Model::Dfsph) return "DFSPH does not run on a device yet (solver.model = wcsph or paper)";
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
-  if (cfg.wall_model == WallModel::Dynamic)
-    return "dynamic walls do not run on a device (boundary.model = akinci or adami)";
   if (cfg.wall_motion.any())
     return "moving walls (boundary.obstacles[].motion) do not run on a device yet (use --backend cpu)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
-  if (cfg.density_evolution == DensityEvolution::Continuity)
-    return "the continuity density does not run on a device yet (solver.density = summation)";
   return {};
 }
 

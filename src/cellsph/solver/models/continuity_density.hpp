@@ -82,9 +82,8 @@ struct ContinuityIntegratePass {
 };
 
 // Pressures of `set` (the fluid) from their carried densities.
-template <int Dim, class Real>
-void continuity_state(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                      const IndexSet& set) {
+template <int Dim, class Real, class Set>
+void continuity_state(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set) {
   run_pass(set, ContinuityStatePass<Dim, Real>{pv, cfg.eos});
 }
 
@@ -104,9 +103,8 @@ Real reference_sound_speed(const SolverConfig<Dim, Real>& cfg) {
 }
 
 // d rho / dt of `set` (the fluid), after the kick (models/wcsph.hpp), before the drift.
-template <int Dim, class Real>
-void continuity_rate(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                     const IndexSet& set) {
+template <int Dim, class Real, class Set>
+void continuity_rate(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set) {
   const Real h = smoothing_length(cfg);
   const auto kind = cfg.density_diffusion.kind;
   const Real dhc =

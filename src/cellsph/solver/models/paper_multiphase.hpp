@@ -163,16 +163,15 @@ struct PaperTension {
 };
 
 // Normals of `set` (pv.normal sized for every particle).
-template <int Dim, class Real>
-void paper_normals(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
-                   const IndexSet& set) {
+template <int Dim, class Real, class Set>
+void paper_normals(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set) {
   run_pass(set, PaperNormalsPass<Dim, Real>{pv, Poly6Kernel<Dim, Real>(cfg.support),
                                             cfg.tension == TensionModel::Akinci});
 }
 
 // Forces of `set`, after the densities (and the normals, if tension.needs_normals()) they read.
-template <int Dim, class Real>
-void paper_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& set,
+template <int Dim, class Real, class Set>
+void paper_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set,
                   PaperTension tension, bool wall_states) {
   const Poly6Kernel<Dim, Real> wc(cfg.support);
   with_kernel<Dim, Real>(cfg.pressure_kernel, cfg.support, [&](const auto wp) {

@@ -1,0 +1,399 @@
+#!/usr/bin/python3
+"""Runs a validation scene and compares its probes with the experiment (docs/physics.md, "Validation").
+
+Usage: scripts/validate.py CASE [--spacing S] [--until T] [--build DIR] [--out RUN_DIR] [--no-run]
+                           [--threads N] [--figure FILE.png] [--walls MODEL] [--set /POINTER=VALUE ...]
+
+CASE is `lobovsky` (built-in scene lobovsky-2014: Lobovsky et al. 2014, H = 0.3 m, 2D), `spheric`
+(built-in scene spheric-test2: SPHERIC Test 2, Kleefsman et al. 2005, 3D) or `martin-moyce-a` /
+`martin-moyce-b` (dam-break-2d's set-up against Martin & Moyce 1952's residual column height at the back
+wall, tables [A] and [B] of data/validation/martin_moyce_1952.txt: [A] the scene's 1 m x 2 m column in its
+4 m tank, tau = t sqrt(g / a) <= 2.5; [B] a 1 m square column in an 8 m tank, tau <= 6.3; the level on
+the vertical 2 spacings from the back wall, one support length, against the table within 0.05 of the
+column height, issue 14's target; --walls picks the wall model). The scene is run with
+`cellsph run` at spacing S (support 2 S; the tank, the column and the wall sensors follow the spacing's
+lattice, see below) until T, into RUN_DIR (default validate-CASE-S); --no-run only compares an existing
+RUN_DIR. Then, against the data of data/validation/:
+  - arrival time at every gauge outside the initial column: the first time the level reaches the
+    threshold (Lobovsky 0.1 H = 0.03 m, SPHERIC 0.05 m: a film thinner than about half the support reads
+    as dry, 0.04 m at the coarsest SPHERIC spacing), linearly interpolated between samples, for the run
+    and for each measured curve;
+  - level RMS error over the window (Lobovsky T = t sqrt(g/H) < 6, SPHERIC the first 2 s, or up to T if
+    shorter) against the measured curve (Lobovsky: the mean of its two series, whose own half-difference
+    is printed as the experiment's spread), as a fraction of the gauge's measured peak level in the window;
+  - SPHERIC: the peak pressure and its time at every sensor over the first impact (t < 1 s), P1 being the
+    issue's target.
+Prints one line per quantity with the issue's target and "met" or "MISSED"; writes the figure (default
+RUN_DIR/validation.png; matplotlib from Debian). Exits 0 when it could compare, whatever the result
+(a report, not a test: the CI bounds are in src/cellsph/scene/validation_test.cpp).
+
+Geometry at other spacings (the scene files are written for their own spacing): a block or wall spans
+round(L / S) spacings from its min corner (docs/scenes.md), so for SPHERIC the tank ends at x = W =
+round(3.22 / S) S, the column is the round(1.228 / S) spacings before W (it ends at the wall), and a
+pressure sensor is half a spacing outside the box's lattice face (round(0.161 / S) S from its corner).
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+G = 9.81
+
+LOBOVSKY = {
+    "scene": "lobovsky-2014",
+    "data": "lobovsky2014_water_levels_H300.tsv",
+    "H": 0.3,
+    "gauges": {"h_x0300": 0.300, "h_x0865": 0.865, "h_x1114": 1.114, "h_x1363": 1.3625},
+    "in_column": {"h_x0300"},
+    "threshold": 0.03,  # [m], 0.1 H
+}
+SPHERIC = {
+    "scene": "spheric-test2",
+    "data": "spheric_test2_kleefsman2005.tsv",
+    "gauges": {"level_x1488": 1.488, "level_x0992": 0.992, "level_x0496": 0.496, "level_x2638": 2.638},
+    "in_column": {"level_x2638"},
+    "threshold": 0.05,  # [m]
+    "sensors_front": [0.021, 0.061, 0.101, 0.141],  # P1-P4: z on the face x = 0.8245
+    "sensors_top": [0.8035, 0.7635, 0.7235, 0.6835],  # P5-P8: x on the top z = 0.161
+    "sensor_y": 0.471,
+}
+
+
+def read_table(path):
+    """A tab- or comma-separated table: '#' lines are comments, the first other line the header."""
+    lines = [ln.rstrip("\n") for ln in open(path) if ln.strip() and not ln.startswith("#")]
+    if not lines:
+        sys.exit(f"{path}: no header and no data")
+    sep = "\t" if "\t" in lines[0] else ","
+    head = [h.strip() for h in lines[0].split(sep)]
+    cols = {h: [] for h in head}
+    for n, line in enumerate(lines[1:], start=2):
+        fields = line.split(sep)
+        if len(fields) != len(head):
+            sys.exit(f"{path}: data line {n}: {len(fields)} fields, the header has {len(head)}")
+        for h, v in zip(head, fields):
+            try:
+                cols[h].append(float(v) if v.strip() else math.nan)
+            except ValueError:
+                sys.exit(f"{path}: data line {n}, column '{h}': not a number: '{v}'")
+    return head, cols
+
+
+def interp(ts, vs, t):
+    """Linear interpolation of (ts, vs) at t (ts ascending); the end values outside."""
+    if t <= ts[0]:
+        return vs[0]
+    if t >= ts[-1]:
+        return vs[-1]
+    lo, hi = 0, len(ts) - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if ts[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    f = (t - ts[lo]) / (ts[hi] - ts[lo]) if ts[hi] > ts[lo] else 0.0
+    return vs[lo] + f * (vs[hi] - vs[lo])
+
+
+def arrival(ts, vs, threshold):
+    """First time the series reaches threshold, linearly interpolated; None if it never does."""
+    for k, v in enumerate(vs):
+        if not math.isnan(v) and v >= threshold:
+            if k == 0:
+                return ts[0]
+            v0 = vs[k - 1] if not math.isnan(vs[k - 1]) else 0.0
+            return ts[k - 1] + (threshold - v0) / (v - v0) * (ts[k] - ts[k - 1])
+    return None
+
+
+def rms_error(ts, vs, ref_t, ref_v, t_end):
+    """RMS of (run - reference) over the run's samples with t <= t_end (NaN samples read as dry, 0)."""
+    d = [(0.0 if math.isnan(v) else v) - interp(ref_t, ref_v, t) for t, v in zip(ts, vs) if t <= t_end]
+    return math.sqrt(sum(x * x for x in d) / len(d)) if d else math.nan
+
+
+def peak(ts, vs, t_end):
+    best = (math.nan, -math.inf)
+    for t, v in zip(ts, vs):
+        if t <= t_end and not math.isnan(v) and v > best[1]:
+            best = (t, v)
+    return best
+
+
+def lround(x):
+    """C's lround for x >= 0 (halves away from zero, as the scene reader counts spacings; Python's
+    round() takes halves to even)."""
+    return math.floor(x + 0.5)
+
+
+def spheric_geometry(s):
+    """The --set edits that place SPHERIC Test 2's tank, column and sensors on the lattice of spacing s."""
+    n_tank = lround(3.22 / s)
+    w = n_tank * s
+    x0 = w - lround(1.228 / s) * s
+    face = 0.6635 + lround(0.161 / s) * s
+    top = lround(0.161 / s) * s
+    c = SPHERIC
+    probes = [{"name": n, "kind": "layer", "at": [x, 0.5, 0]} for n, x in c["gauges"].items()]
+    probes += [{"name": f"P{k + 1}", "kind": "pressure", "at": [face + s / 2, c["sensor_y"], z]}
+               for k, z in enumerate(c["sensors_front"])]
+    probes += [{"name": f"P{k + 5}", "kind": "pressure", "at": [x, c["sensor_y"], top + s / 2]}
+               for k, x in enumerate(c["sensors_top"])]
+    return [f"/fluids/0/min=[{x0!r}, 0, 0]", f"/fluids/0/max=[{w!r}, 1.0, 0.55]",
+            f"/boundary/walls/max=[{w!r}, 1.0, 1.0]", "/probes=" + json.dumps(probes)]
+
+
+def martin_moyce(table):
+    """Table [A] or [B]'s residual height: (tau, H) pairs, the second table of the section."""
+    out, section, tables, numbers = [], None, 0, False
+    for line in open(os.path.join(ROOT, "data", "validation", "martin_moyce_1952.txt")):
+        if line.startswith("# ["):
+            section, tables, numbers = line[2:5], 0, False
+        elif not line.strip() or line.startswith("#"):
+            numbers = False
+        else:
+            if not numbers:
+                tables += 1
+            numbers = True
+            if section == table and tables == 2:
+                tau, h = map(float, line.split()[:2])
+                out.append((tau, h))
+    return out
+
+
+MM = {"A": {"height": 2.0, "tank": 4.0, "tau_max": 2.5}, "B": {"height": 1.0, "tank": 8.0, "tau_max": 7.0}}
+
+
+def run_scene(a, case):
+    scene = case["scene"] if isinstance(case, dict) and "scene" in case else "dam-break-2d"
+    cmd = [os.path.join(a.build, "cellsph"), "run", scene, "--until", str(a.until), "--out", a.out,
+           "--fps", "1", "--threads", str(a.threads), "--quiet",
+           "--set", f"/spacing={a.spacing!r}", "--set", f"/solver/support={2 * a.spacing!r}"]
+    if case is SPHERIC:
+        for e in spheric_geometry(a.spacing):
+            cmd += ["--set", e]
+    if case in ("A", "B"):
+        m = MM[case]
+        probe = [{"name": "wall", "kind": "level", "at": [2 * a.spacing, 0]}]
+        cmd += ["--set", f"/fluids/0/max=[1.0, {m['height']}]", "--set", f"/boundary/walls/max/0={m['tank']}",
+                "--set", f"/domain/max/0={m['tank'] + 0.5}", "--set", f"/boundary/model={a.walls}",
+                "--set", "/probes_every=0.005", "--set", "/probes=" + json.dumps(probe)]
+    for e in a.set:
+        cmd += ["--set", e]
+    print("validate.py: " + " ".join(cmd if case is not SPHERIC else cmd[:17]) + " ...", flush=True)
+    r = subprocess.run(cmd)
+    if r.returncode != 0:
+        sys.exit(f"validate.py: cellsph run failed (exit {r.returncode})")
+
+
+def verdict(ok):
+    return "met" if ok else "MISSED"
+
+
+def compare_lobovsky(run_dir, t_end):
+    c = LOBOVSKY
+    _, data = read_table(os.path.join(ROOT, "data", "validation", c["data"]))
+    _, sim = read_table(os.path.join(run_dir, "probes.csv"))
+    scale_t = math.sqrt(c["H"] / G)
+    dt = [T * scale_t for T in data["T"]]
+    window = min(6 * scale_t, sim["time"][-1])
+    print(f"Lobovsky et al. 2014 (H = 0.3 m), window t <= {window:.3f} s (T <= {window / scale_t:.2f})")
+    curves, rows = {}, []
+    for g in c["gauges"]:
+        series = [k for k in data if k == g or k.startswith(g + "_")]
+        meas = [[v * c["H"] for v in data[k]] for k in series]
+        mean = [sum(vs) / len(vs) for vs in zip(*meas)]
+        curves[g] = (dt, meas, series)
+        in_w = [m for t, m in zip(dt, mean) if t <= window]
+        top = max(in_w)
+        err = rms_error(sim["time"], sim[g], dt, mean, window)
+        spread = 0.0
+        if len(meas) == 2:
+            d = [(u - v) / 2 for t, u, v in zip(dt, *meas) if t <= window]
+            spread = math.sqrt(sum(x * x for x in d) / len(d))
+        line = (f"  {g}: level RMS error {err:.4f} m = {100 * err / top:.1f}% of the peak {top:.3f} m "
+                f"(target 10%: {verdict(err <= 0.1 * top)}; the two series differ by {100 * spread / top:.1f}%)")
+        rows.append({"gauge": g, "rms": err, "peak": top, "rms_frac": err / top})
+        if g not in c["in_column"]:
+            t_sim = arrival(sim["time"], sim[g], c["threshold"])
+            t_exp = [arrival(dt, m, c["threshold"]) for m in meas]
+            t_ref = sum(t_exp) / len(t_exp)
+            if t_sim is None:
+                line += f"\n    arrival ({c['threshold']} m): never in the run; experiment {t_ref:.3f} s: MISSED"
+            else:
+                rel = (t_sim - t_ref) / t_ref
+                line += (f"\n    arrival ({c['threshold']} m): {t_sim:.3f} s, experiment {t_ref:.3f} s (series "
+                         + ", ".join(f"{t:.3f}" for t in t_exp) + f"): {100 * rel:+.1f}% "
+                         f"(target 5%: {verdict(abs(rel) <= 0.05)})")
+                rows[-1].update(arrival=t_sim, arrival_exp=t_ref, arrival_rel=rel)
+        print(line)
+    return sim, curves, rows, window
+
+
+def compare_spheric(run_dir, t_end):
+    c = SPHERIC
+    _, data = read_table(os.path.join(ROOT, "data", "validation", c["data"]))
+    _, sim = read_table(os.path.join(run_dir, "probes.csv"))
+    dt = data["t_s"]
+    window = min(2.0, sim["time"][-1])
+    print(f"SPHERIC Test 2 (Kleefsman et al. 2005), window t <= {window:.3f} s")
+    rows = []
+    for g in c["gauges"]:
+        in_w = [v for t, v in zip(dt, data[g]) if t <= window]
+        top = max(in_w)
+        err = rms_error(sim["time"], sim[g], dt, data[g], window)
+        line = (f"  {g}: level RMS error {err:.4f} m = {100 * err / top:.1f}% of the peak {top:.3f} m "
+                f"(target 10%: {verdict(err <= 0.1 * top)})")
+        rows.append({"gauge": g, "rms": err, "peak": top, "rms_frac": err / top})
+        if g not in c["in_column"]:
+            t_sim = arrival(sim["time"], sim[g], c["threshold"])
+            t_exp = arrival(dt, data[g], c["threshold"])
+            if t_sim is None:
+                line += f"\n    arrival ({c['threshold']} m): never in the run; experiment {t_exp:.3f} s: MISSED"
+            else:
+                line += (f"\n    arrival ({c['threshold']} m): {t_sim:.3f} s, experiment {t_exp:.3f} s: "
+                         f"{t_sim - t_exp:+.3f} s (target 0.02 s: {verdict(abs(t_sim - t_exp) <= 0.02)})")
+                rows[-1].update(arrival=t_sim, arrival_exp=t_exp)
+        print(line)
+    impact = min(1.0, sim["time"][-1])
+    for k in range(1, 9):
+        name = f"P{k}"
+        ts, ps = peak(sim["time"], sim[name], impact)
+        te, pe = peak(dt, data[name], impact)
+        if math.isnan(ts):
+            print(f"  {name}: no fluid at the sensor up to t = {impact:g} s; experiment peak {pe:.0f} Pa at {te:.3f} s")
+            continue
+        line = f"  {name}: peak {ps:.0f} Pa at {ts:.3f} s, experiment {pe:.0f} Pa at {te:.3f} s (t <= {impact:g} s)"
+        if k == 1:
+            line += (f": time {ts - te:+.3f} s (target 0.02 s: {verdict(abs(ts - te) <= 0.02)}), pressure "
+                     f"{100 * (ps - pe) / pe:+.1f}% (target 25%: {verdict(abs(ps - pe) <= 0.25 * pe)})")
+            rows.append({"gauge": name, "peak_time": ts, "peak_time_exp": te, "peak": ps, "peak_exp": pe})
+        print(line)
+    if sim["time"][-1] >= 1.0:
+        def mean(ts, ps):
+            v = [p for t, p in zip(ts, ps) if 0.45 <= t <= 1.0 and not math.isnan(p)]
+            return sum(v) / len(v)
+        ms, me = mean(sim["time"], sim["P1"]), mean(dt, data["P1"])
+        print(f"  P1: mean over 0.45-1 s (the load after the impact) {ms:.0f} Pa, experiment {me:.0f} Pa: "
+              f"{100 * (ms - me) / me:+.1f}%")
+    return sim, data, rows, window
+
+
+def compare_martin_moyce(run_dir, table):
+    m = MM[table]
+    _, sim = read_table(os.path.join(run_dir, "probes.csv"))
+    worst = 0.0
+    print(f"Martin & Moyce 1952, table [{table}] (column 1 m x {m['height']:g} m, tank {m['tank']:g} m), "
+          "residual height at the back wall H = h / column height")
+    pts = []
+    for tau, h_ref in martin_moyce(f"[{table}]"):
+        t = tau / math.sqrt(G)
+        if tau <= 0 or tau > m["tau_max"] or t > sim["time"][-1]:
+            continue
+        h = interp(sim["time"], sim["wall"], t) / m["height"]
+        worst = max(worst, abs(h - h_ref))
+        pts.append((tau, h_ref, h))
+        print(f"  tau = {tau:4.2f} (t = {t:.3f} s): Martin & Moyce {h_ref:.2f}, run {h:.3f} ({h - h_ref:+.3f})")
+    print(f"  worst {worst:.3f} (target 0.05: {verdict(worst <= 0.05)})")
+    return sim, pts
+
+
+def figure(path, case, sim, ref, window, title):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        sys.exit("validate.py: needs matplotlib (apt-get install python3-matplotlib)")
+    if case in ("A", "B"):
+        fig, ax = plt.subplots(1, 1, figsize=(6, 3.6))
+        scale = math.sqrt(G)  # tau = t sqrt(g / a), a = 1 m
+        ax.plot([t * scale for t in sim["time"]], [v / MM[case]["height"] for v in sim["wall"]], "C0-",
+                label="cellsph, level 2 spacings from the wall")
+        ax.plot([p[0] for p in ref], [p[1] for p in ref], "ko", ms=4, label="Martin & Moyce 1952")
+        ax.set_xlabel("tau = t sqrt(g / a)")
+        ax.set_ylabel("residual height / column height")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    elif case is LOBOVSKY:
+        fig, axes = plt.subplots(2, 2, figsize=(9, 5.5), sharex=True)
+        for ax, g in zip(axes.flat, case["gauges"]):
+            dt, meas, series = ref[g]
+            for m, s, style in zip(meas, series, ("k.", "kx")):
+                ax.plot([t for t in dt if t <= window * 1.3], m[:sum(t <= window * 1.3 for t in dt)], style, ms=2.5,
+                        label=f"experiment {s}")
+            ax.plot(sim["time"], sim[g], "C0-", lw=1.4, label="cellsph")
+            ax.set_title(f"level at x = {case['gauges'][g]} m", fontsize=9)
+            ax.set_ylabel("level [m]")
+            ax.grid(alpha=0.3)
+        axes[0, 0].legend(fontsize=7)
+        for ax in axes[1]:
+            ax.set_xlabel("time since the gate started [s]")
+    else:
+        fig, axes = plt.subplots(4, 2, figsize=(10, 9), sharex=True)
+        names = list(case["gauges"]) + ["P1", "P3", "P5", "P7"]
+        for k, (ax, g) in enumerate(zip(axes.T.flat, names)):
+            m = [i for i, t in enumerate(ref["t_s"]) if t <= max(window, sim["time"][-1]) + 0.1]
+            ax.plot([ref["t_s"][i] for i in m], [ref[g][i] for i in m], "k-", lw=0.6, label="experiment")
+            ax.plot(sim["time"], sim[g], "C0-", lw=1.2, label="cellsph")
+            ax.set_title(f"level at x = {case['gauges'][g]} m" if k < 4 else f"pressure {g}", fontsize=9)
+            ax.set_ylabel("level [m]" if k < 4 else "p [Pa]")
+            ax.grid(alpha=0.3)
+        axes[0, 0].legend(fontsize=7)
+        for ax in axes[-1]:
+            ax.set_xlabel("time [s]")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    print(f"validate.py: wrote {path}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("case", choices=["lobovsky", "spheric", "martin-moyce-a", "martin-moyce-b"])
+    ap.add_argument("--walls", default="adami", choices=["adami", "akinci", "dynamic"])
+    ap.add_argument("--set", action="append", default=[], help="a further scene edit, as cellsph run's --set")
+    ap.add_argument("--spacing", type=float)
+    ap.add_argument("--until", type=float)
+    ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
+    ap.add_argument("--out")
+    ap.add_argument("--no-run", action="store_true")
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--figure")
+    a = ap.parse_args()
+    case = {"lobovsky": LOBOVSKY, "spheric": SPHERIC, "martin-moyce-a": "A", "martin-moyce-b": "B"}[a.case]
+    if a.spacing is None:
+        a.spacing = {"lobovsky": 0.005, "spheric": 0.02}.get(a.case, 0.05)
+    if not a.spacing > 0:
+        sys.exit(f"--spacing: must be > 0, got {a.spacing}")
+    if a.until is None:
+        a.until = {"lobovsky": 6 * math.sqrt(LOBOVSKY["H"] / G), "spheric": 2.0,
+                   "martin-moyce-a": 2.5 / math.sqrt(G), "martin-moyce-b": 6.35 / math.sqrt(G)}[a.case]
+    a.out = a.out or f"validate-{a.case}-{a.spacing:g}"
+    if not a.no_run:
+        run_scene(a, case)
+    if not os.path.exists(os.path.join(a.out, "probes.csv")):
+        sys.exit(f"{os.path.join(a.out, 'probes.csv')}: not found (run without --no-run first)")
+    if case in ("A", "B"):
+        sim, ref = compare_martin_moyce(a.out, case)
+        window = None
+        title = (f"dam-break-2d set-up, {a.walls} walls, spacing {a.spacing:g} m, against Martin & Moyce "
+                 f"1952 [{case}]")
+    elif case is LOBOVSKY:
+        sim, ref, _, window = compare_lobovsky(a.out, a.until)
+        title = (f"lobovsky-2014, 2D WCSPH, spacing {a.spacing:g} m (H / {0.3 / a.spacing:.0f}), "
+                 "against Lobovsky et al. 2014 (two series)")
+    else:
+        sim, ref, _, window = compare_spheric(a.out, a.until)
+        title = f"spheric-test2, 3D WCSPH, spacing {a.spacing:g} m, against Kleefsman et al. 2005"
+    figure(a.figure or os.path.join(a.out, "validation.png"), case, sim, ref, window, title)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
