@@ -162,8 +162,14 @@ void check_inside(const Simulation<Dim, Real>& sim, const nlohmann::json& j, con
   }
 }
 
+// energy_bound false: a scene with moving obstacles (dam-break-gate, wave-tank), whose walls do work on the
+// fluid (the wave maker all the time), so its energy has no bound of this kind: it is checked for
+// finiteness and containment only, and says so in its output line. (The same scenes with the motions
+// removed are not a substitute: a 2 m column held by the still gate, and the still flume, both gain 10% of
+// m g H within 1800-4000 steps at this resolution, the open wall-energy problem of Adami walls at water's
+// viscosity, docs/physics.md.)
 template <int Dim, class Real>
-void run_scene(const nlohmann::json& j, const std::string& name) {
+void run_scene(const nlohmann::json& j, const std::string& name, bool energy_bound = true) {
   // The source read_scene_json gives a built-in scene (its meshes/FILE are the compiled-in meshes).
   auto scene = load_scene<Dim, Real>(j, "built-in scene " + name);
   ScopedThreads one(1);
@@ -211,12 +217,21 @@ void run_scene(const nlohmann::json& j, const std::string& name) {
     }
     const double e = energy(sim);
     emax = std::max(emax, e);
-    ASSERT_LE(e, e0 + tol) << name << ": step " << s << ": energy " << e << " > initial " << e0 << " + "
-                           << tol;
+    if (energy_bound) {
+      ASSERT_LE(e, e0 + tol) << name << ": step " << s << ": energy " << e << " > initial " << e0 << " + "
+                             << tol;
+    }
     if (s % 50 == 0 || s == kSteps - 1) {
       check_inside(sim, j, name, s);
       if (::testing::Test::HasFatalFailure()) return;
     }
+  }
+  if (!energy_bound) {
+    std::cout << "[stability] " << name
+              << " (moving walls, energy not bounded: they do work): " << sim.fluid_count()
+              << " fluid particles, " << kSteps << " steps to t = " << sim.time() << " s, energy " << e0
+              << " -> " << energy(sim) << "\n";
+    return;
   }
   std::cout << "[stability] " << name << ": " << sim.fluid_count() << " fluid particles, " << kSteps
             << " steps to t = " << sim.time() << " s, energy " << e0 << " -> " << energy(sim)
@@ -230,12 +245,16 @@ TEST_P(SceneStability, CoarsenedStaysFiniteInsideAndEnergyBounded) {
   std::string src;
   const auto j = coarsened(read_scene_json(GetParam(), src));
   const auto h = read_scene_header(j, src);
+  // Moving obstacles (boundary.obstacles[k].motion): no energy bound (see run_scene).
+  bool moving = false;
+  if (j.contains("boundary") && j["boundary"].contains("obstacles"))
+    for (const auto& o : j["boundary"]["obstacles"]) moving = moving || o.contains("motion");
   // Double precision everywhere: float scenes are run in double here (the float path is compared with
   // double in the solver's tests); the physics is the same.
   if (h.dim == 2)
-    run_scene<2, double>(j, GetParam());
+    run_scene<2, double>(j, GetParam(), !moving);
   else
-    run_scene<3, double>(j, GetParam());
+    run_scene<3, double>(j, GetParam(), !moving);
 }
 
 std::vector<std::string> scene_names() {

@@ -110,6 +110,24 @@ void SolverConfig<Dim, Real>::validate() const {
       bad("density", "number", "the DFSPH model uses the mass density (density = mass)");
   }
   if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
+  for (std::size_t k = 0; k < wall_motion.motions.size(); ++k) {
+    const WallMotion& m = wall_motion.motions[k];
+    const std::string key = "wall_motion[" + std::to_string(k) + "].";
+    if (m.kind == MotionKind::Oscillate) {
+      positive(key + "period", m.period);
+      non_negative(key + "amplitude", m.amplitude);
+    }
+    if ((m.kind == MotionKind::Translate || m.kind == MotionKind::Rotate) && !(m.end >= m.start))
+      bad(key + "end", m.end, "must not be before start");
+    if (m.kind == MotionKind::Table &&
+        !(m.table_begin < m.table_end && m.table_end <= wall_motion.rows.size()))
+      bad(key + "table", m.table_end, "names no rows of the motion tables");
+  }
+  for (const std::int32_t m : wall_motion.of_particle)
+    if (m < -1 || (m >= 0 && static_cast<std::size_t>(m) >= wall_motion.motions.size()))
+      bad("wall_motion.of_particle", m, "is not -1 or a motion's index");
+  if (wall_motion.any() && time.mode == TimeStepping::PerParticle)
+    bad("time.mode", "per-particle", "moving walls need global time steps (fixed or courant)");
 }
 
 std::string_view model_name(Model m) {

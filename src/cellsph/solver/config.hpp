@@ -12,6 +12,7 @@
 #include "cellsph/physics/eos.hpp"
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/solver/backend.hpp"
+#include "cellsph/solver/boundary/wall_motion.hpp"
 
 namespace cellsph {
 
@@ -181,6 +182,9 @@ struct SolverConfig {
   // particle's viscosity against a wall at rest, as between two fluid particles).
   bool no_slip = false;
   WallModel wall_model = WallModel::Akinci;
+  // Moving walls (boundary/wall_motion.hpp; scene key boundary.obstacles[k].motion): the prescribed
+  // motions and which boundary particle each moves. Empty: every wall at rest. CPU steps only.
+  WallMotions wall_motion{};
   Real restitution = Real(0.2);
   Real friction = Real(0.1);
 

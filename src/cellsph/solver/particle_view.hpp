@@ -51,6 +51,7 @@ struct ParticleView {
   V* normal = nullptr;            // CSF / Akinci 2013 colour normal
   V* f_pressure = nullptr;        // WCSPH: pressure force, applied after the predicted velocity
   V* wall_v = nullptr;            // Adami: extrapolated no-slip velocity of a wall particle
+  const V* wall_a = nullptr;      // moving walls (boundary/wall_motion.hpp): acceleration; null: all at rest
   Real* wall_self_rho = nullptr;  // dynamic walls: the fixed wall-wall part of the density
   Real* drho = nullptr;           // WCSPH continuity density: d rho / dt of this step
   Real* df_alpha = nullptr;       // DFSPH (models/dfsph.hpp): 1 / (the factor's denominator)

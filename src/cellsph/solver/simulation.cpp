@@ -111,6 +111,22 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   if (const auto err = id_permutation_error(p_.id); !err.empty()) throw InputError("particles: " + err);
   rho0_.assign(n, Real(0));
   state_.assign_zero(n);
+  // Moving walls: each particle's motion and initial position, kept by id (the input order's index is
+  // lost when the boundary is reordered below).
+  if (cfg_.wall_motion.any()) {
+    const auto& of = cfg_.wall_motion.of_particle;
+    if (of.size() != n)
+      throw InputError("particles: the wall motions name " + std::to_string(of.size()) +
+                       " particles, there are " + std::to_string(n));
+    x0_of_id_.assign(n, V{});
+    motion_of_id_.assign(n, -1);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (of[i] >= 0 && p_.kind[i] != kBoundary)
+        throw InputError("particles: fluid particle " + std::to_string(i) + " is given a wall motion");
+      x0_of_id_[p_.id[i]] = p_.x[i];
+      motion_of_id_[p_.id[i]] = of[i];
+    }
+  }
 
   fluid_count_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -177,8 +193,37 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   // weights, whose sums then run in that order too).
   if (cfg_.reorder_every > 0) reorder_slots(boundary_);
   init_boundary_weights();
+  set_moving_slots();
+  move_walls(time_);
   lists_valid_ = false;
   if (cfg_.backend != Backend::Cpu) use_backend(cfg_.backend);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::set_moving_slots() {
+  moving_.clear();
+  moving_x0_.clear();
+  moving_motion_.clear();
+  if (!cfg_.wall_motion.any()) return;
+  for (const std::uint32_t b : boundary_) {
+    const std::int32_t m = motion_of_id_[p_.id[b]];
+    if (m < 0) continue;
+    moving_.push_back(b);
+    moving_x0_.push_back(x0_of_id_[p_.id[b]]);
+    moving_motion_.push_back(m);
+  }
+  wall_a_.assign(p_.size(), V{});
+}
+
+// Moving walls at time t (boundary/wall_motion.hpp): positions, velocities and accelerations from the
+// initial positions; walls at rest keep v = 0.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::move_walls(Real t) {
+  if (moving_.empty()) return;
+  run_pass(moving_.size(), MovingWallPass<Dim, Real>{p_.x.data(), p_.v.data(), wall_a_.data(), moving_.data(),
+                                                     moving_x0_.data(), moving_motion_.data(),
+                                                     cfg_.wall_motion.motions.data(),
+                                                     cfg_.wall_motion.rows.data(), static_cast<double>(t)});
 }
 
 template <int Dim, class Real>
@@ -192,6 +237,7 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.normal = normal_.data();
   v.f_pressure = f_pressure_.data();
   v.wall_v = wall_v_.data();
+  v.wall_a = wall_a_.empty() ? nullptr : wall_a_.data();
   v.wall_self_rho = wall_self_rho_.data();
   v.drho = drho_.data();
   v.df_alpha = df_alpha_.data();
@@ -282,8 +328,10 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   }
   if (lists_valid_ && skin_ > 0) {
     // The largest squared displacement since the lists were built (order-free: a maximum).
-    const Real d2 =
-        reduce_max(fluid_, MaxValue<Real>{}, MaxDisplacementPass<Dim, Real>{view(), x_built_.data()}).value;
+    // Moving walls count too: a pair's distance changes by at most the sum of both displacements.
+    const MaxDisplacementPass<Dim, Real> disp{view(), x_built_.data()};
+    Real d2 = reduce_max(fluid_, MaxValue<Real>{}, disp).value;
+    if (!moving_.empty()) d2 = std::max(d2, reduce_max(moving_, MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
     if (d2 <= limit * limit) return;
   }
@@ -534,6 +582,7 @@ void Simulation<Dim, Real>::step() {
   time_ += dt;
   last_dt_ = dt;
   ++steps_;
+  move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
   timings_.integration += sw.ms();
 }
 
@@ -557,6 +606,7 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   time_ += dt;
   last_dt_ = dt;
   ++steps_;
+  move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
   timings_.integration += sw.ms();
 }
 
@@ -689,7 +739,10 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
   // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
   // the file's fault, named as such (the Simulation is then not usable; the caller stops).
+  set_moving_slots();
   if (cfg_.wall_model == WallModel::Dynamic) {
+    // Moving walls: the fixed share is that of the initial positions, as at construction.
+    for (std::size_t k = 0; k < moving_.size(); ++k) p_.x[moving_[k]] = moving_x0_[k];
     try {
       init_boundary_weights();
     } catch (const CapacityError& e) {
@@ -700,6 +753,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   last_dt_ = state.last_dt;
   steps_ = state.steps;
   leapfrog_started_ = state.leapfrog_started;
+  move_walls(time_);
   if (device_) {
     upload_to_device();
     host_stale_ = false;

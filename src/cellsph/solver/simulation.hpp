@@ -174,6 +174,11 @@ class Simulation {
   void upload_to_device();
   void sync_host() const;
   void init_boundary_weights();
+  // Moving walls (boundary/wall_motion.hpp): the slots of the moving wall particles with their initial
+  // positions and motions, from the particles' ids (set_moving_slots), and their state at time t
+  // (move_walls: position, velocity, acceleration; a pure function of t and the initial position).
+  void set_moving_slots();
+  void move_walls(Real t);
   void step_per_particle();
   void step_dfsph(Stopwatch& sw);
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
@@ -242,6 +247,18 @@ class Simulation {
   bool leapfrog_started_ = false;  // v holds v(t - dt/2)
 
   StepTimings timings_;
+
+  // Moving walls (config wall_motion): per particle id, the initial position and the motion (-1: at
+  // rest), taken from the particles given at construction (the scene's, so a resume built from the same
+  // scene has them: nothing of this is in a checkpoint); per moving wall k, its slot, initial position
+  // and motion (boundary slots never change after construction; rebuilt from the ids on restore); each
+  // wall particle's acceleration (Adami's pressure reads it; empty when nothing moves).
+  std::vector<V> x0_of_id_;
+  std::vector<std::int32_t> motion_of_id_;
+  IndexList moving_;
+  std::vector<V> moving_x0_;
+  std::vector<std::int32_t> moving_motion_;
+  std::vector<V> wall_a_;
 
   // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
   // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.

@@ -1,9 +1,11 @@
 #pragma once
-// Boundary particles after Adami, Hu & Adams 2012 (WallModel::Adami), for walls at rest (a_w = 0): each
-// step every wall particle w gets, from its fluid neighbours f (wall_neighbors.hpp),
-//   p_w = (sum_f p_f W_wf + g . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf       (their eq. 27)
+// Boundary particles after Adami, Hu & Adams 2012 (WallModel::Adami): each step every wall particle w
+// gets, from its fluid neighbours f (wall_neighbors.hpp),
+//   p_w = (sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf (their eq. 27)
 //   rho_w = the density at which the equation of state gives p_w                 (their eq. 28)
-//   v~_w = 2 v_w - sum_f v_f W_wf / sum_f W_wf = -(the kernel average)            (their eq. 22-23)
+//   v~_w = 2 v_w - sum_f v_f W_wf / sum_f W_wf                                   (their eq. 22-23)
+// with v_w and a_w the wall's prescribed velocity and acceleration (particles' v and wall_a; 0 for walls
+// at rest, boundary/wall_motion.hpp)
 // and the fluid-wall forces are then the fluid's own pair terms with these values (models/).
 #include <cstddef>
 #include <type_traits>
@@ -41,7 +43,8 @@ struct Adami2012WallStatePass {
       vsum += pv.v[f] * wwf;
     }
     // A wall particle no fluid particle reaches is read by no force; it keeps rest values.
-    Real pw = wsum > 0 ? (psum + dot(gravity, rsum)) / wsum : Real(0);
+    const V g = pv.wall_a ? V(gravity - pv.wall_a[b]) : gravity;  // the wall's frame sees g - a_w
+    Real pw = wsum > 0 ? (psum + dot(g, rsum)) / wsum : Real(0);
     if (eos.clamp_negative && pw < 0) pw = 0;
     const Real rhow = eos.density(pw, pv.rho0[b]);
     pv.p[b] = pw;

@@ -61,6 +61,8 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.model == Model::Dfsph) return "DFSPH does not run on a device yet (solver.model = wcsph or paper)";
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
+  if (cfg.wall_motion.any())
+    return "moving walls (boundary.obstacles[].motion) do not run on a device yet (use --backend cpu)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
   return {};
 }

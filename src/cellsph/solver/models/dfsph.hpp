@@ -66,15 +66,15 @@ CELLSPH_HD inline Vec<Dim, Real> dfsph_grad(const ParticleView<Dim, Real>& pv, c
   return (xi - pv.x[*it]) * pv.df_grad[it - pv.within];
 }
 
-// D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, at rest), over i's rows, with the step's
-// gradients.
+// D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, their prescribed velocity), over i's rows, with
+// the step's gradients (df_grad, written by the density pass).
 template <int Dim, class Real>
 CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i) {
   const Vec<Dim, Real> xi = pv.x[i], vi = pv.v[i];
   Real d = 0;
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
     const std::uint32_t j = *it;
-    d += continuity_term(dfsph_grad(pv, xi, it), pv.m[j], pv.is_fluid(j) ? vi - pv.v[j] : vi);
+    d += continuity_term(dfsph_grad(pv, xi, it), pv.m[j], vi - pv.v[j]);
   }
   return d;
 }
@@ -192,7 +192,7 @@ struct DfsphNonPressurePass {
       if (pv.is_fluid(j))
         f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
       else if (no_slip)
-        f += morris_viscosity_force(vi, g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
+        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
     }
     pv.f[i] = f;
   }

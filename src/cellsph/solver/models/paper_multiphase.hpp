@@ -106,7 +106,7 @@ struct PaperForcesPass {
         // (boundary/akinci2012.hpp): i's density (mirrored, so that its volume psi_b / rho_i matches how
         // i sees fluid neighbours; with rho0 instead a resting fluid is pushed off the walls), i's
         // pressure extrapolated to it, and i's colour (walls are neutral to interface tension); no slip:
-        // eq. 8b against a particle at rest with i's mu.
+        // eq. 8b against the wall particle's velocity (0 at rest) with i's mu.
         const Real mj = pv.m[j];
         if (wall_states) {
           const Real vol_j = pv.vol[j];
@@ -116,7 +116,8 @@ struct PaperForcesPass {
         } else {
           const Real pj = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
           f += averaged_pressure_force(wp.gradW(xij), mi / rhoi, mj / rhoi, pi, pj);
-          if (no_slip) f += averaged_viscosity_force(vel_i, vol_i, mj / rhoi, mui, mui, wv.laplacian(r));
+          if (no_slip)
+            f += averaged_viscosity_force(vel_i - pv.v[j], vol_i, mj / rhoi, mui, mui, wv.laplacian(r));
         }
         if (eq9) accumulate_color(cf, xij, r, mj / rhoi, pv.color[i], wc);
       }

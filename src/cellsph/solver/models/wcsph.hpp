@@ -68,7 +68,7 @@ struct WcsphForcesPass {
       } else if (wall_states) {
         // Adami / dynamic walls: the fluid pair terms with the wall's pressure, density and velocity
         // (boundary/adami2012.hpp, boundary/dynamic_crespo2007.hpp); the laminar viscosity takes i's mu
-        // and the wall's no-slip velocity, the artificial one the wall's own (at rest).
+        // and the wall's no-slip velocity, the artificial one the wall's own (its prescribed velocity).
         fp += symmetric_pressure_force(g, mi, pv.m[j], prho2_i, pv.prho2[j]);
         if (no_slip && laminar)
           fnp += morris_viscosity_force(V(vel_i - pv.wall_v[j]), g, xij, r, vol_i, pv.vol[j], mui, mui, eta2);
@@ -78,13 +78,15 @@ struct WcsphForcesPass {
         if (any_tension) accumulate_color(cf, xij, r, pv.m[j] / rhoi, Real(1), wc);
       } else {
         // Akinci walls (boundary/akinci2012.hpp): mirrored density, extrapolated pressure; no slip:
-        // the laminar operator against a particle at rest with volume psi_b / rho_i and i's mu.
+        // the laminar operator against the wall particle's velocity (0 at rest, boundary/wall_motion.hpp)
+        // with volume psi_b / rho_i and i's mu.
         const Real pb = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
         fp += boundary_pressure_force(g, mi, rhoi, pi, pb, pv.m[j]);
         if (no_slip && laminar)
-          fnp += morris_viscosity_force(vel_i, g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
+          fnp += morris_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
         if (av_walls && alpha_c0_h > 0)
-          fnp += artificial_viscosity_force(vel_i, g, xij, r, mi, pv.m[j], rhoi, rhoi, alpha_c0_h, eta2);
+          fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, rhoi,
+                                            alpha_c0_h, eta2);
         if (any_tension) accumulate_color(cf, xij, r, pv.m[j] / rhoi, Real(1), wc);
       }
     }
