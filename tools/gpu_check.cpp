@@ -210,8 +210,10 @@ int main(int argc, char** argv) {
     // 1e-5 of the extent is ~100 float ulps of it. Double: the 1e-9.
     compare_steps<3, float>("dam-break-3d", steps, 1e-5);
     compare_steps<2, double>("dam-break-2d", steps, 1e-9);
-    compare_steps<2, double>("hydrostatic-tank", steps, 1e-9);  // continuity density + Fourtakas
-    compare_steps<2, double>("two-phase", steps, 1e-9);         // the paper's model, leap-frog
+    compare_steps<2, double>("hydrostatic-tank", steps, 1e-9);    // continuity density + Fourtakas
+    compare_steps<2, double>("two-phase", steps, 1e-9);           // the paper's model, leap-frog
+    compare_steps<2, double>("dam-break-2d-dfsph", steps, 1e-9);  // DFSPH: solves, warm starts, sums
+    compare_steps<2, double>("dam-break-gate", steps, 1e-9);      // a moving wall (the gate)
     bench(sizes, 3, bench_steps, sizes.front());
   } catch (const std::exception& e) {
     std::printf("FAIL exception: %s\n", e.what());

@@ -74,6 +74,11 @@ double reduce_sum_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
   return s;
 }
 
+// The number of indices of a set (a device set, device_driver.hpp, has its own overload).
+inline std::size_t set_size(const IndexSet& set) {
+  return set.size();
+}
+
 template <class Pass>
 double reduce_sum(const IndexSet& set, const Pass& pass) {
   return reduce_sum_n(set.data(), set.size(), pass);

@@ -785,13 +785,22 @@ void Simulation<Dim, Real>::upload_to_device() {
   device_->upload(p_);
   if (cfg_.wall_model == WallModel::Dynamic && !boundary_.empty())
     device_->upload_wall_self_density(wall_self_rho_);
+  if (!moving_.empty()) device_->upload_wall_motion(moving_, moving_x0_, moving_motion_);
+  if (cfg_.model == Model::Dfsph) device_->upload_solver_state(state_);
 }
 
 // One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH or
 // the paper's model with global steps, on the device's copy of the particles.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step_device() {
-  const DeviceStepResult<Real> r = device_->step(last_dt_, leapfrog_started_);
+  DeviceStepInput<Real> in{time_, last_dt_, leapfrog_started_};
+  if (cfg_.model == Model::Dfsph) {
+    if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);  // m, rho0: on the host
+    in.step = steps_ + 1;
+    in.dfsph_diameter = df_diameter_;
+    in.dfsph = &dfsph_stats_;
+  }
+  const DeviceStepResult<Real> r = device_->step(in);
   if (cfg_.model == Model::PaperMultiphase) leapfrog_started_ = true;
   host_stale_ = true;
   timings_.neighbors += r.neighbors_ms;
@@ -810,6 +819,7 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::sync_host() const {
   if (!host_stale_) return;
   device_->download(p_);
+  if (cfg_.model == Model::Dfsph) device_->download_solver_state(state_);
   host_stale_ = false;
 }
 

@@ -113,7 +113,10 @@ class Simulation {
   // Checkpoints (written by io/simulation_checkpoint.hpp): the particles (every field of the field list),
   // the solver state (the same order) and this integrator state. Restoring the three into a Simulation
   // built from the same config and continuing gives results bit-identical to an uninterrupted run.
-  [[nodiscard]] const SolverState<Dim, Real>& solver_state() const { return state_; }
+  [[nodiscard]] const SolverState<Dim, Real>& solver_state() const {
+    sync_host();
+    return state_;
+  }
   [[nodiscard]] IntegratorState<Real> integrator_state() const {
     return {time_, last_dt_, steps_, leapfrog_started_};
   }
@@ -262,7 +265,7 @@ class Simulation {
 
   // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
   // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.
-  SolverState<Dim, Real> state_;
+  mutable SolverState<Dim, Real> state_;  // mutable: copied back from a device with the particles
   // Model::Dfsph (models/dfsph.hpp): alpha and the sweep's k are rebuilt each step.
   std::vector<Real> df_alpha_, df_kappa_;
   // Per pair slot of the rows (nl_.indices.size()): the step's kernel gradients as W'(r)/r (one scalar,

@@ -27,6 +27,11 @@ struct DeviceIndexSet {
   std::size_t size = 0;
 };
 
+template <class Space>
+std::size_t set_size(const DeviceIndexSet<Space>& set) {
+  return set.size;
+}
+
 // Every index in [0, n).
 template <class Space>
 struct DeviceRange {

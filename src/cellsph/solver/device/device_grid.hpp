@@ -21,6 +21,7 @@
 
 #include "cellsph/core/hd.hpp"
 #include "cellsph/core/vec.hpp"
+#include "cellsph/neighbors/hmask.hpp"
 
 namespace cellsph {
 
@@ -47,16 +48,24 @@ struct BoundsPass {
   CELLSPH_HD BoundsMax<Dim, Real> operator()(std::size_t i) const { return {x[i], -x[i]}; }
 };
 
+// The grid over the particles' bounding box. Cells are a little larger than the support (by
+// kCellInflation, the CPU grids' margin, neighbors/hmask.hpp) and coordinates are computed in double: a pair
+// that passes the row test distance2 <= h^2 in Real is then never two cells apart, whatever the rounding of a
+// coordinate near a cell face (with cells of exactly h, computed in Real, a lattice pair at distance h could
+// land two cells apart and be lost: DeviceGrid.LatticeWithPairsAtTheSupportGivesTheExactRows). The margin
+// covers float's rounding of the distance test (a few 1e-7) and double's of a coordinate over at most 2^30
+// cells (about 1e-7 of a cell); it costs about 2^-16 more candidates.
+
 template <int Dim, class Real>
 struct GridGeometry {
-  Vec<Dim, Real> lo;
-  Real inv_cell = 0;
+  double lo[Dim] = {};
+  double inv_cell = 0;
   std::uint32_t dims[Dim] = {};
 
   CELLSPH_HD std::uint32_t coord(Real x, int a) const {
-    const Real q = std::floor((x - lo[a]) * inv_cell);
+    const double q = std::floor((static_cast<double>(x) - lo[a]) * inv_cell);
     if (!(q > 0)) return 0;  // also NaN (the stability check stops such a run after the step)
-    const auto c = static_cast<std::uint32_t>(q < Real(dims[a] - 1) ? q : Real(dims[a] - 1));
+    const auto c = static_cast<std::uint32_t>(q < double(dims[a] - 1) ? q : double(dims[a] - 1));
     return c;
   }
   CELLSPH_HD std::uint32_t cell_of(const Vec<Dim, Real>& x) const {

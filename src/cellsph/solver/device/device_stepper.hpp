@@ -18,6 +18,7 @@
 #include "cellsph/core/timer.hpp"
 #include "cellsph/solver/boundary/adami2012.hpp"
 #include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
+#include "cellsph/solver/boundary/wall_motion.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_driver.hpp"
 #include "cellsph/solver/device/device_grid.hpp"
@@ -25,6 +26,7 @@
 #include "cellsph/solver/device/memory_space.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
 #include "cellsph/solver/models/continuity_density.hpp"
+#include "cellsph/solver/models/dfsph.hpp"
 #include "cellsph/solver/models/paper_multiphase.hpp"
 #include "cellsph/solver/models/summation_density.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
@@ -52,6 +54,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     }
     phases_.upload(params.data(), params.size());
     planes_.upload(cfg_.planes.data(), cfg_.planes.size());
+    motions_.upload(cfg_.wall_motion.motions.data(), cfg_.wall_motion.motions.size());
+    motion_rows_.upload(cfg_.wall_motion.rows.data(), cfg_.wall_motion.rows.size());
   }
 
   void upload(const Particles<Dim, Real>& p) override {
@@ -84,9 +88,19 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     wall_self_rho_.upload(rho.data(), n_);
   }
 
+  void upload_wall_motion(const std::vector<std::uint32_t>& slot, const std::vector<V>& x0,
+                          const std::vector<std::int32_t>& motion) override {
+    CELLSPH_CHECK(slot.size() == x0.size() && slot.size() == motion.size(), "one entry per moving wall");
+    moving_.upload(slot.data(), slot.size());
+    moving_x0_.upload(x0.data(), x0.size());
+    moving_motion_.upload(motion.data(), motion.size());
+    wall_a_.resize(slot.empty() ? 0 : n_);
+    wall_a_.zero();
+  }
+
   void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
 
-  DeviceStepResult<Real> step(Real last_dt, bool leapfrog_started) override {
+  DeviceStepResult<Real> step(const DeviceStepInput<Real>& in) override {
     DeviceStepResult<Real> r;
     Stopwatch sw;
     build_rows();
@@ -94,41 +108,42 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     r.neighbors_ms = sw.ms();
 
     sw.reset();
-    const auto pv = view();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
-    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
-    if (continuity())
-      continuity_state(cfg_, pv, fluid);
-    else
-      summation_density(cfg_, pv, fluid);
-    if (wall_states_ && cfg_.wall_model == WallModel::Dynamic)
-      dynamic_wall_states(cfg_, pv, boundary);
-    else if (wall_states_)
-      adami2012_wall_states(cfg_, pv, boundary);
-    if (paper())
-      forces_paper(pv, fluid);
-    else
-      wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
-    Ops::synchronize();
-    r.forces_ms = sw.ms();
-
-    sw.reset();
-    r.dt = global_courant_dt(cfg_, pv, fluid);
-    if (paper()) {
-      const Real kick = leapfrog_started ? (last_dt + r.dt) / 2 : r.dt / 2;  // Simulation::integrate_paper
-      run_pass(fluid, PaperLeapFrogPass<Dim, Real>{pv, kick, r.dt});
+    if (cfg_.model == Model::Dfsph) {
+      r.dt = dfsph(in, fluid);
+      Ops::synchronize();
+      r.forces_ms = sw.ms();
+      sw.reset();
     } else {
-      integrate(pv, fluid, r.dt);
+      explicit_step(in, fluid, r, sw);
     }
+    const auto pv = view();
     if (cfg_.box.enabled || !cfg_.planes.empty()) {
       auto walls = box_plane_collisions(cfg_, pv);
       walls.planes = planes_.data();  // the device's copy of cfg.planes
       run_pass(fluid, walls);
     }
     r.first_bad = first_where(fluid, stability_check(cfg_, pv));
+    // The walls where the next step sees them, at the Simulation's new time (time_ += dt, in Real).
+    if (moving_.size() > 0) {
+      const Real t = in.time + r.dt;
+      run_pass(DeviceRange<Space>{moving_.size()},
+               MovingWallPass<Dim, Real>{d_.x.data(), d_.v.data(), wall_a_.data(), moving_.data(),
+                                         moving_x0_.data(), moving_motion_.data(), motions_.data(),
+                                         motion_rows_.data(), static_cast<double>(t)});
+    }
     Ops::synchronize();
     r.integration_ms = sw.ms();
     return r;
+  }
+
+  void upload_solver_state(const SolverState<Dim, Real>& s) override {
+    df_kappa_v_.upload(s.dfsph_kappa_v.data(), s.dfsph_kappa_v.size());
+  }
+
+  void download_solver_state(SolverState<Dim, Real>& s) override {
+    s.dfsph_kappa_v.resize(df_kappa_v_.size());
+    df_kappa_v_.download(s.dfsph_kappa_v.data());
   }
 
   DeviceRows neighbor_rows() override {
@@ -160,6 +175,11 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.wall_v = wall_v_.data();
     v.drho = drho_.data();
     v.wall_self_rho = wall_self_rho_.data();
+    v.wall_a = wall_a_.size() > 0 ? wall_a_.data() : nullptr;
+    v.df_alpha = df_alpha_.data();
+    v.df_kappa = df_kappa_.data();
+    v.df_kappa_v = df_kappa_v_.data();
+    v.df_grad = df_grad_.data();
     v.offsets = offsets_.data();
     v.candidates = rows_.data();
     v.within = rows_.data();
@@ -171,6 +191,50 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   }
 
   bool paper() const { return cfg_.model == Model::PaperMultiphase; }
+
+  // WCSPH or the paper's model (Simulation::step's sequence): density, wall states, forces, dt, integration.
+  void explicit_step(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid,
+                     DeviceStepResult<Real>& r, Stopwatch& sw) {
+    const auto pv = view();
+    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
+    if (continuity())
+      continuity_state(cfg_, pv, fluid);
+    else
+      summation_density(cfg_, pv, fluid);
+    if (wall_states_ && cfg_.wall_model == WallModel::Dynamic)
+      dynamic_wall_states(cfg_, pv, boundary);
+    else if (wall_states_)
+      adami2012_wall_states(cfg_, pv, boundary);
+    if (paper())
+      forces_paper(pv, fluid);
+    else
+      wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
+    Ops::synchronize();
+    r.forces_ms = sw.ms();
+
+    sw.reset();
+    r.dt = global_courant_dt(cfg_, pv, fluid);
+    if (paper()) {
+      const Real kick = in.leapfrog_started ? (in.last_dt + r.dt) / 2 : r.dt / 2;  // integrate_paper
+      run_pass(fluid, PaperLeapFrogPass<Dim, Real>{pv, kick, r.dt});
+    } else {
+      integrate(pv, fluid, r.dt);
+    }
+  }
+
+  // DFSPH (models/dfsph.hpp, Simulation::step_dfsph): the step to the drift over the device's exact rows; its
+  // per-pair gradient factors sized from them, the divergence warm start carried (upload_solver_state).
+  Real dfsph(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid) {
+    CELLSPH_CHECK(in.dfsph != nullptr, "a DFSPH step needs its statistics");
+    df_alpha_.resize(n_);
+    df_kappa_.resize(n_);
+    if (df_kappa_v_.size() != n_) {
+      df_kappa_v_.resize(n_);
+      df_kappa_v_.zero();
+    }
+    df_grad_.resize(rows_.size());
+    return dfsph_step(cfg_, view(), fluid, in.dfsph_diameter, *in.dfsph, in.step);
+  }
 
   // Simulation::compute_forces_paper: the colour normals (every particle's cleared first) when the tension
   // model needs them, then the forces (models/paper_multiphase.hpp).
@@ -215,12 +279,12 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     const auto b = reduce_max(DeviceIndexSet<Space>{identity_.data(), n_}, BoundsMax<Dim, Real>{},
                               BoundsPass<Dim, Real>{d_.x.data()});
     GridGeometry<Dim, Real> g;
-    g.inv_cell = Real(1) / cfg_.support;
+    g.inv_cell = 1.0 / (static_cast<double>(cfg_.support) * kCellInflation);
     double cells = 1;
     for (int a = 0; a < Dim; ++a) {
-      g.lo[a] = -b.neg_lo[a];
-      const double extent = double(b.hi[a]) - double(g.lo[a]);
-      const double d = std::floor(extent * double(g.inv_cell)) + 1;
+      g.lo[a] = -static_cast<double>(b.neg_lo[a]);
+      const double extent = double(b.hi[a]) - g.lo[a];
+      const double d = std::floor(extent * g.inv_cell) + 1;
       cells *= d;
       if (!(cells <= double(kMaxCells)))
         throw SimulationError("the particles spread over more than " + std::to_string(kMaxCells) +
@@ -285,7 +349,15 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
   Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
+  Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_grad_;  // DFSPH (models/dfsph.hpp)
   Array<V> f_pressure_, wall_v_, normal_;
+  // Moving walls: the config's motions and table rows; per moving wall its slot, initial position, motion;
+  // every particle's wall acceleration (empty when nothing moves).
+  Array<WallMotion> motions_;
+  Array<MotionTableRow> motion_rows_;
+  Array<std::uint32_t> moving_;
+  Array<V> moving_x0_, wall_a_;
+  Array<std::int32_t> moving_motion_;
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;
   Array<V> xs_;

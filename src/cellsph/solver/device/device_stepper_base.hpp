@@ -23,6 +23,22 @@ struct DeviceStepResult {
   double integration_ms = 0;
 };
 
+// What a step needs of the Simulation's state: the clock (moving walls), and for the paper's leap-frog the
+// last step and whether the leap-frog has started.
+struct DfsphStats;  // models/dfsph.hpp
+
+template <class Real>
+struct DeviceStepInput {
+  Real time = 0;
+  Real last_dt = 0;
+  bool leapfrog_started = false;
+  // DFSPH: the number of the step being taken (1-based, for messages), the particle diameter of its CFL
+  // step (computed once by the Simulation) and the statistics the step adds to.
+  std::uint64_t step = 0;
+  Real dfsph_diameter = 0;
+  DfsphStats* dfsph = nullptr;
+};
+
 // The device's neighbour rows copied to the host (tests, scripts/gpu_check.sh). Row i of a fluid particle
 // is rows[offsets[i] .. offsets[i] + count[i]); wall row b is wall_rows[wall_start[b] .. wall_start[b + 1])
 // (empty without wall states).
@@ -46,11 +62,20 @@ class DeviceStepperBase {
   virtual void upload_wall_self_density(const std::vector<Real>& rho) = 0;
   // Every field back into p (resized).
   virtual void download(Particles<Dim, Real>& p) = 0;
+  // The solver state carried between steps (SolverState, particles.hpp: DFSPH's divergence warm start), to
+  // the device after upload() and back (for checkpoints) with download_solver_state().
+  virtual void upload_solver_state(const SolverState<Dim, Real>& s) = 0;
+  virtual void download_solver_state(SolverState<Dim, Real>& s) = 0;
+  // Moving walls (boundary/wall_motion.hpp): per moving wall k its slot, initial position and motion (the
+  // Simulation's, after upload()); the motions themselves come with the config.
+  virtual void upload_wall_motion(const std::vector<std::uint32_t>& slot,
+                                  const std::vector<Vec<Dim, Real>>& x0,
+                                  const std::vector<std::int32_t>& motion) = 0;
   // One step of Simulation::step() with a global step: neighbour rows, density, wall states, forces (WCSPH
-  // or the paper's model), dt, integration (symplectic Euler or the paper's leap-frog, whose kick needs the
-  // last step and whether the leap-frog has started: the Simulation's state), box and planes, the
-  // stability check. Positions are left as computed even when the check fails (as on the CPU).
-  virtual DeviceStepResult<Real> step(Real last_dt, bool leapfrog_started) = 0;
+  // or the paper's model), dt, integration (symplectic Euler or the paper's leap-frog), box and planes, the
+  // stability check, then the moving walls at the new time. Positions are left as computed even when the
+  // check fails (as on the CPU).
+  virtual DeviceStepResult<Real> step(const DeviceStepInput<Real>& in) = 0;
   // The rows of the current positions (built afresh), copied to the host.
   virtual DeviceRows neighbor_rows() = 0;
 };
@@ -58,11 +83,8 @@ class DeviceStepperBase {
 // Empty when the device step runs this config; otherwise what it lacks, in one phrase.
 template <int Dim, class Real>
 std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
-  if (cfg.model == Model::Dfsph) return "DFSPH does not run on a device yet (solver.model = wcsph or paper)";
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
-  if (cfg.wall_motion.any())
-    return "moving walls (boundary.obstacles[].motion) do not run on a device yet (use --backend cpu)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
   return {};
 }

@@ -223,8 +223,8 @@ struct DfsphSolveResult {
 
 // One solve (density or divergence): warm start, then sweeps until the average error is at most eta
 // (relative) after at least min_it sweeps, or max_it sweeps were made.
-template <int Dim, class Real, class Kernel>
-DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const IndexSet& set, const Kernel& w, Real dt,
+template <int Dim, class Real, class Kernel, class Set>
+DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
                              std::uint32_t min_neighbors) {
   const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc};
@@ -234,7 +234,7 @@ DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const IndexSet& 
                                                    acc, min_neighbors});
   if (warm_start) run_pass(set, kick);
   const DfsphSourcePass<Dim, Real, Kernel> source{pv, w, dt, density, false, Real(0), acc, min_neighbors};
-  const double n = static_cast<double>(std::max<std::size_t>(set.size(), 1));
+  const double n = static_cast<double>(std::max<std::size_t>(set_size(set), 1));
   DfsphSolveResult r;
   for (;;) {
     r.error = reduce_sum(set, source) / n;
@@ -256,8 +256,8 @@ Real dfsph_particle_diameter(const ParticleView<Dim, Real>& pv, const IndexSet& 
 // One DFSPH step of the particles of `fluid` (rows filtered to h, pv's DFSPH arrays sized for every
 // particle). Returns dt. Throws SimulationError when a solve's error is not finite. `step` is the number of
 // the step being taken (1-based), for messages.
-template <int Dim, class Real>
-Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const IndexSet& fluid,
+template <int Dim, class Real, class Set>
+Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& fluid,
                 Real diameter, DfsphStats& st, std::uint64_t step) {
   const Real h = cfg.support;
   Real rho0_min = std::numeric_limits<Real>::max(), nu_max = 0;
