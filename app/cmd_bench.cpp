@@ -53,6 +53,7 @@ struct BenchArgs {
   int dim = 3;
   int repeat = 3;
   bool quick = false;
+  bool unsorted_rows = false;
 };
 
 // ---- memory of this process, from /proc (Linux) --------------------------------------------------
@@ -148,6 +149,13 @@ Row measure(const std::vector<Vec<Dim, double>>& x, double radius, const SearchO
       row.stats = s;
       row.lists_bytes = nl.memory_bytes();
       if (reset && hwm) row.peak_growth_bytes = (*hwm > *rss0 ? *hwm - *rss0 : 0) * 1024;
+      // Rows left in the search's order are sorted here, untimed, so the checksum still compares
+      // neighbour sets.
+      if (!opt.sorted_rows)
+        parallel_for(nl.size(), [&](std::size_t i) {
+          std::sort(nl.indices.begin() + static_cast<std::ptrdiff_t>(nl.offsets[i]),
+                    nl.indices.begin() + static_cast<std::ptrdiff_t>(nl.offsets[i + 1]));
+        });
       row.checksum = checksum(nl);
     } else {
       row.stats.build_ms = std::min(row.stats.build_ms, s.build_ms);
@@ -183,7 +191,8 @@ void bench_set(const std::string& title, const std::vector<Vec<Dim, double>>& x,
     }
     Row r;
     try {
-      r = measure<Dim>(x, radius, {.method = m, .subdivision = a.subdivision}, a.repeat);
+      r = measure<Dim>(
+          x, radius, {.method = m, .subdivision = a.subdivision, .sorted_rows = !a.unsorted_rows}, a.repeat);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {
@@ -281,8 +290,8 @@ void run_bench_neighbors(const BenchArgs& a) {
 
   ScopedThreads threads(a.threads_given ? a.threads : max_threads());
   std::printf(
-      "cellsph bench neighbors: %dD, double, %d thread(s), subdivision H=%d, best of up to %d run(s)\n",
-      a.dim, max_threads(), a.subdivision, a.repeat);
+      "cellsph bench neighbors: %dD, double, %d thread(s), subdivision H=%d, best of up to %d run(s)%s\n",
+      a.dim, max_threads(), a.subdivision, a.repeat, a.unsorted_rows ? ", cell-index rows unsorted" : "");
   std::printf(
       "  times: build = structure, query = all CSR lists (NeighborSearch::find_all); cand/nbr = distance\n"
       "  tests per neighbour found; stats = memory_bytes reported by the search; lists = CSR size;\n"
@@ -544,6 +553,9 @@ void register_bench(CLI::App& app, int& result) {
   nb->add_option("--repeat", args->repeat, "runs per measurement; the fastest is reported")
       ->capture_default_str();
   nb->add_flag("--quick", args->quick, "small sizes only (3000 points), for tests and docs");
+  nb->add_flag("--unsorted-rows", args->unsorted_rows,
+               "cell-index leaves rows in its own order (SearchOptions::sorted_rows = false); the other "
+               "methods sort as always");
   nb->callback([args, threads, &result] {
     args->threads_given = threads->count() > 0;
     run_bench_neighbors(*args);

@@ -100,6 +100,37 @@ __attribute__((target("avx2"))) std::uint64_t hits64_avx2(const Real* const* ax,
   return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
 }
 
+// Permutations that move the lanes set in an 8-bit mask to the front, in order (left-packing).
+struct LeftPackTable {
+  alignas(32) std::uint32_t lane[256][8];
+  std::uint8_t count[256];
+  constexpr LeftPackTable() : lane{}, count{} {
+    for (int m = 0; m < 256; ++m) {
+      int c = 0;
+      for (int t = 0; t < 8; ++t)
+        if ((m >> t) & 1) lane[m][c++] = static_cast<std::uint32_t>(t);
+      count[m] = static_cast<std::uint8_t>(c);
+    }
+  }
+};
+inline constexpr LeftPackTable kLeftPack{};
+
+// Writes id[t] for every bit t set in bits (t < m <= 64) to dst, in order; returns how many. Writes
+// up to 8 entries past the last one and reads up to 8 past id[m - 1] (both must be padding).
+__attribute__((target("avx2"))) inline std::uint32_t left_pack_avx2(const std::uint32_t* id,
+                                                                    std::uint64_t bits, std::uint32_t m,
+                                                                    std::uint32_t* dst) {
+  std::uint32_t c = 0;
+  for (std::uint32_t t = 0; t < m && (bits >> t) != 0; t += 8) {
+    const auto k = static_cast<unsigned>((bits >> t) & 0xFFu);
+    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(id + t));
+    const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(kLeftPack.lane[k]));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + c), _mm256_permutevar8x32_epi32(v, perm));
+    c += kLeftPack.count[k];
+  }
+  return c;
+}
+
 // in[0, L) distinct, with 8 entries of UINT32_MAX after them.
 __attribute__((target("avx2"))) inline void rank_sort_avx2(const std::uint32_t* in, std::uint32_t L,
                                                            std::uint32_t* out) {
@@ -129,7 +160,8 @@ class CellIndex {
  public:
   using Point = Vec<Dim, Real>;
 
-  explicit CellIndex(const SearchOptions& opt = {}) : subdivision_(opt.subdivision) {
+  explicit CellIndex(const SearchOptions& opt = {})
+      : subdivision_(opt.subdivision), sorted_rows_(opt.sorted_rows) {
     if (subdivision_ < 1) {
       std::ostringstream os;
       os << "cell-index: subdivision H must be >= 1, got " << subdivision_;
@@ -219,9 +251,8 @@ class CellIndex {
   std::uint64_t for_each_pair(F&& f) const {
     return traverse<true>([&](std::uint32_t p, const Block& blk) {
       const std::uint32_t i = ids_[p];
-      Real xi[Dim];
-      for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) { f(i, j, block_dist2(blk, xi, t)); });
+      const Probe pr = probe(p);
+      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) { f(i, j, block_dist2(blk, pr.x, t)); });
     });
   }
 
@@ -235,12 +266,10 @@ class CellIndex {
     }
     std::uint64_t* counts = out.offsets.data() + 1;
     const std::uint64_t candidates = traverse<false>([&](std::uint32_t p, const Block& blk) {
-      Real xi[Dim];
-      for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-      const Real hi2 = hs_[p] * hs_[p];
+      const Probe pr = probe(p);
       std::uint64_t c = 0;
       for (std::uint32_t b = 0; b < blk.n; b += 64)
-        c += popcount64(hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b)));
+        c += popcount64(hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b)));
       // p itself is among its candidates at distance 0 <= h^2 and was counted once.
       counts[ids_[p]] = c - 1;
     });
@@ -259,20 +288,27 @@ class CellIndex {
       const std::uint32_t i = ids_[p];
       std::uint32_t* row = idx + off[i];
       const std::uint64_t len = off[i + 1] - off[i];
-      // Typical rows are gathered in a small buffer and placed by rank; long ones go to std::sort.
+      // Typical rows are gathered in a small buffer (written 8 at a time, which would overrun the
+      // row into the next one) and placed by rank; long ones are written in place.
       std::uint32_t buf[kRankSortMax + 8];
-      std::uint32_t* dst = len <= kRankSortMax ? buf : row;
       std::uint64_t c = 0;
-      for_each_hit(p, blk, [&](std::uint32_t, std::uint32_t j) {
-        CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
-        dst[c++] = j;
-      });
+      if (len <= kRankSortMax) {
+        c = write_hits(p, blk, buf);
+      } else {
+        for_each_hit(p, blk, [&](std::uint32_t, std::uint32_t j) {
+          CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
+          row[c++] = j;
+        });
+      }
       CELLSPH_CHECK(c == len,
                     "cell-index: fill pass found " << c << " neighbours of " << i << ", counted " << len);
-      if (dst == buf)
+      if (len > kRankSortMax) {
+        if (sorted_rows_) std::sort(row, row + len);
+      } else if (sorted_rows_) {
         rank_sort(buf, static_cast<std::uint32_t>(len), row);
-      else
-        std::sort(row, row + len);
+      } else {
+        std::memcpy(row, buf, len * sizeof(std::uint32_t));
+      }
     });
     return candidates;
   }
@@ -509,13 +545,40 @@ class CellIndex {
 #endif
   }
 
-  // A particle's candidates copied side by side (positions and key-order index q), so that the
-  // distance loop runs over one contiguous block instead of a few short ranges; padded by kPad.
+  // A particle's candidates copied side by side, so that the distance loop runs over one
+  // contiguous block instead of a few short ranges; padded by kPad.
   struct Block {
     const Real* x[Dim];
     const std::uint32_t* id;  // particle indices (only when asked for)
     std::uint32_t n;
+    // The home cell's particles are consecutive in the block: key-order particle p sits at
+    // candidate self0 + (p - p0).
+    std::uint32_t self0, p0;
+    [[nodiscard]] std::uint32_t self(std::uint32_t p) const { return self0 + (p - p0); }
   };
+
+  // One particle's query: its position and h^2.
+  struct Probe {
+    Real x[Dim];
+    Real h2;
+  };
+
+  Probe probe(std::uint32_t p) const {
+    Probe pr{};
+    for (int k = 0; k < Dim; ++k) pr.x[k] = xs_[k][p];
+    pr.h2 = hs_[p] * hs_[p];
+    return pr;
+  }
+
+  // Position in a block filled from ranges r[0, nr) of key-order particle q (which they hold).
+  static std::uint32_t block_pos(const Range* r, int nr, std::uint32_t q) {
+    std::uint32_t o = 0;
+    for (int s = 0; s < nr; ++s) {
+      if (r[s].begin <= q && q < r[s].end) return o + (q - r[s].begin);
+      o += r[s].end - r[s].begin;
+    }
+    return o;  // not reached: the home cell is always among the ranges (its gap is 0)
+  }
 
   struct BlockBuffer {
     std::array<std::vector<Real>, Dim> x;
@@ -524,7 +587,7 @@ class CellIndex {
     // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
     template <bool WithIds>
     Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total) {
-      if (x[0].size() < total + kPad) {
+      if (id.size() < total + kPad) {
         for (auto& v : x) v.resize(total + kPad, Real(0));
         id.resize(total + kPad, 0);
       }
@@ -560,31 +623,57 @@ class CellIndex {
     return s;
   }
 
+  // The hit mask of candidates [b, b + 64) of p's block without p itself.
+  std::uint64_t hits_but_self(std::uint32_t p, const Block& blk, const Probe& pr, std::uint32_t b) const {
+    const std::uint64_t bits = hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b));
+    const std::uint32_t s = blk.self(p) - b;  // wraps to a large value when self < b
+    return s < 64 ? bits & ~(std::uint64_t{1} << s) : bits;
+  }
+
   // Calls g(t, j) for every candidate t of the block, particle j != p, with distance2 <= h_p^2.
   template <class G>
   void for_each_hit(std::uint32_t p, const Block& blk, G&& g) const {
-    const std::uint32_t i = ids_[p];
-    Real xi[Dim];
-    for (int k = 0; k < Dim; ++k) xi[k] = xs_[k][p];
-    const Real hi2 = hs_[p] * hs_[p];
+    const Probe pr = probe(p);
     for (std::uint32_t b = 0; b < blk.n; b += 64) {
       // About 1 candidate in 7 is a neighbour: iterating the set bits of a hit mask costs one
       // step per neighbour and no branch per candidate.
-      std::uint64_t bits = hits64(blk, xi, hi2, b, std::min<std::uint32_t>(64, blk.n - b));
+      std::uint64_t bits = hits_but_self(p, blk, pr, b);
       while (bits != 0) {
         const std::uint32_t t = b + static_cast<std::uint32_t>(std::countr_zero(bits));
-        const std::uint32_t j = blk.id[t];
         bits &= bits - 1;
-        if (j != i) g(t, j);
+        g(t, blk.id[t]);
       }
     }
+  }
+
+  // Writes p's neighbours to dst in block order and returns how many; dst needs 8 spare entries
+  // (the AVX2 path stores 8 at a time).
+  std::uint32_t write_hits(std::uint32_t p, const Block& blk, std::uint32_t* dst) const {
+    const Probe pr = probe(p);
+    std::uint32_t c = 0;
+    for (std::uint32_t b = 0; b < blk.n; b += 64) {
+      std::uint64_t bits = hits_but_self(p, blk, pr, b);
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+      if (avx2_) {
+        c += detail::left_pack_avx2(blk.id + b, bits, std::min<std::uint32_t>(64, blk.n - b), dst + c);
+        continue;
+      }
+#endif
+      while (bits != 0) {
+        dst[c++] = blk.id[b + static_cast<std::uint32_t>(std::countr_zero(bits))];
+        bits &= bits - 1;
+      }
+    }
+    return c;
   }
 
   // Bit t set when distance2(xi, x_{b+t}) <= hi2 for the block's candidates b + t, t < m <= 64.
   // Computed 8 floats (AVX2) or 4 (SSE2) at a time with the same operations in the same order as
   // distance2, so the test is bit-identical to the all-pairs reference. Reads up to kPad entries
   // past b + m (padding).
-  std::uint64_t hits64(const Block& blk, const Real* xi, Real hi2, std::uint32_t b, std::uint32_t m) const {
+  std::uint64_t hits64(const Block& blk, const Probe& pr, std::uint32_t b, std::uint32_t m) const {
+    const Real* xi = pr.x;
+    const Real hi2 = pr.h2;
     const Real* ax[Dim];
     for (int k = 0; k < Dim; ++k) ax[k] = blk.x[k] + b;
 #if defined(CELLSPH_CELL_INDEX_AVX2)
@@ -661,7 +750,10 @@ class CellIndex {
           const std::uint32_t len = home_only.end - home_only.begin;
           for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
             local_tests += len - 1;
-            kernel(p, own_buf.template fill<WithIds>(*this, &home_only, 1, len));
+            Block blk = own_buf.template fill<WithIds>(*this, &home_only, 1, len);
+            blk.self0 = 0;
+            blk.p0 = start[u];
+            kernel(p, blk);
           }
           continue;
         }
@@ -690,7 +782,11 @@ class CellIndex {
         for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
           if (uniform_h_ || hs_[p] == hmax_) {
             // Full support: the whole mask, shared by every such particle of the home cell.
-            if (!gathered) home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total);
+            if (!gathered) {
+              home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total);
+              home_blk.self0 = block_pos(merged.data(), nm, start[u]);
+              home_blk.p0 = start[u];
+            }
             gathered = true;
             local_tests += total - 1;
             kernel(p, home_blk);
@@ -709,7 +805,10 @@ class CellIndex {
               mt += r.end - r.begin;
             }
             local_tests += mt - 1;
-            kernel(p, own_buf.template fill<WithIds>(*this, mine.data(), nk, mt));
+            Block blk = own_buf.template fill<WithIds>(*this, mine.data(), nk, mt);
+            blk.self0 = block_pos(mine.data(), nk, start[u]);
+            blk.p0 = start[u];
+            kernel(p, blk);
           }
         }
       }
@@ -733,6 +832,7 @@ class CellIndex {
   static constexpr std::uint32_t kRankSortMax = 96;
 
   int subdivision_ = 1;
+  bool sorted_rows_ = true;
   bool avx2_ = detail::cpu_has_avx2();
   bool force_wide_ = false;
   std::size_t n_ = 0;

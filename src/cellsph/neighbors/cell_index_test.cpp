@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
@@ -73,7 +74,8 @@ template <int Dim, class Real>
 void expect_exact(const Points<Dim, Real>& x, const std::vector<Real>& h, const std::string& what) {
   const NeighborList ref = all_pairs<Dim, Real>(x, h);
   for (int H : {1, 2, 3})
-    for (bool wide : {false, true})
+    for (bool wide : {false, true}) {
+      std::vector<std::uint32_t> unsorted_one_thread;
       for (int threads : {1, 2}) {
         SCOPED_TRACE(what + " H=" + std::to_string(H) + (wide ? " wide" : " packed") +
                      " threads=" + std::to_string(threads));
@@ -101,7 +103,23 @@ void expect_exact(const Points<Dim, Real>& x, const std::vector<Real>& h, const 
           EXPECT_EQ(d.indices, ref.indices);
           EXPECT_EQ(ns.stats().candidates, cand);
         }
+        // Rows left in the search's order: the same sets, and the same bits for 1 and 2 threads.
+        CellIndex<Dim, Real> cu({.method = Method::CellIndex, .subdivision = H, .sorted_rows = false});
+        cu.force_wide_keys(wide);
+        cu.build(x, h);
+        NeighborList e;
+        cu.find_all(e);
+        EXPECT_EQ(e.offsets, ref.offsets);
+        if (threads == 1)
+          unsorted_one_thread = e.indices;
+        else
+          EXPECT_EQ(e.indices, unsorted_one_thread);
+        for (std::size_t i = 0; i + 1 < e.offsets.size(); ++i)
+          std::sort(e.indices.begin() + static_cast<std::ptrdiff_t>(e.offsets[i]),
+                    e.indices.begin() + static_cast<std::ptrdiff_t>(e.offsets[i + 1]));
+        EXPECT_EQ(e.indices, ref.indices);
       }
+    }
 }
 
 template <int Dim, class Real>
@@ -192,6 +210,40 @@ TEST(CellIndex, MatchesAllPairs3DFloat) {
 }
 TEST(CellIndex, MatchesAllPairs3DDouble) {
   run_point_sets<3, double>();
+}
+
+// Pairs whose distance differs from h by less than float could resolve (a few ulps of double up to
+// 1e-6 h), in a box 300 h wide: the SIMD test in double must decide each as distance2 does.
+TEST(CellIndex, PairsWithinUlpsOfTheSupportMatchAllPairs) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double h = 0.37;
+  Points<3, double> x;
+  for (int c = 0; c < 200; ++c) {
+    const Vec<3, double> o{{300 * h * u(rng), 300 * h * u(rng), 300 * h * u(rng)}};
+    x.push_back(o);
+    for (double rel : {-1e-6, -1e-7, -3e-8, -1e-15, 0.0, 1e-15, 3e-8, 1e-7, 1e-6}) {
+      // A random direction, then the distance nudged until distance2 falls where we want it.
+      Vec<3, double> d{{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5}};
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (int k = 0; k < 3; ++k) d[k] *= h * (1 + rel) / len;
+      x.push_back({{o[0] + d[0], o[1] + d[1], o[2] + d[2]}});
+    }
+  }
+  const std::vector<double> hv(x.size(), h);
+  const NeighborList ref = all_pairs<3, double>(x, hv);
+  std::size_t near = 0;  // pairs within float's resolution of the support
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (std::size_t j = 0; j < x.size(); ++j)
+      near += i != j && std::abs(distance2(x[i], x[j]) - h * h) < 1e-6 * h * h ? 1 : 0;
+  EXPECT_GT(near, 1000u);
+  CellIndex<3, double> ci;
+  ci.build(x, hv);
+  NeighborList a;
+  ci.find_all(a);
+  EXPECT_EQ(a.offsets, ref.offsets);
+  EXPECT_EQ(a.indices, ref.indices);
+  EXPECT_EQ(via_visitor(ci, x).indices, ref.indices);
 }
 
 TEST(CellIndex, WidensKeysWhenEq17DoesNotFit) {

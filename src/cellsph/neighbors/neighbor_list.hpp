@@ -28,6 +28,10 @@ struct SearchOptions {
   int subdivision = 1;
   // Spatial Hashing table size M (eq. 15); 0 picks a prime near 2 * number of particles.
   std::size_t hash_table_size = 0;
+  // Cell Indexing only: false leaves each row in the search's own order (cell by cell, a
+  // deterministic function of the positions) instead of ascending, which saves sorting every row.
+  // Every other method, and every caller that compares lists across methods, keeps it true.
+  bool sorted_rows = true;
 };
 
 struct SearchStats {
