@@ -284,7 +284,7 @@ class CellIndex {
     out.indices.resize(total);
     std::uint32_t* idx = out.indices.data();
     const std::uint64_t* off = out.offsets.data();
-    traverse<true>([&](std::uint32_t p, const Block& blk) {
+    auto fill = [&](std::uint32_t p, const Block& blk) {
       const std::uint32_t i = ids_[p];
       std::uint32_t* row = idx + off[i];
       const std::uint64_t len = off[i + 1] - off[i];
@@ -302,14 +302,20 @@ class CellIndex {
       }
       CELLSPH_CHECK(c == len,
                     "cell-index: fill pass found " << c << " neighbours of " << i << ", counted " << len);
+      // Rows of a block sorted by index come out ascending already.
+      const bool sort = sorted_rows_ && !blk.by_id;
       if (len > kRankSortMax) {
-        if (sorted_rows_) std::sort(row, row + len);
-      } else if (sorted_rows_) {
+        if (sort) std::sort(row, row + len);
+      } else if (sort) {
         rank_sort(buf, static_cast<std::uint32_t>(len), row);
       } else {
         std::memcpy(row, buf, len * sizeof(std::uint32_t));
       }
-    });
+    };
+    if (sorted_rows_)
+      traverse<true, true>(fill);
+    else
+      traverse<true>(fill);
     return candidates;
   }
 
@@ -552,9 +558,14 @@ class CellIndex {
     const std::uint32_t* id;  // particle indices (only when asked for)
     std::uint32_t n;
     // The home cell's particles are consecutive in the block: key-order particle p sits at
-    // candidate self0 + (p - p0).
+    // candidate self0 + (p - p0), unless the block was sorted by particle index (by_id), which
+    // moves them to self_pos[p - p0].
     std::uint32_t self0, p0;
-    [[nodiscard]] std::uint32_t self(std::uint32_t p) const { return self0 + (p - p0); }
+    const std::uint32_t* self_pos;
+    bool by_id;
+    [[nodiscard]] std::uint32_t self(std::uint32_t p) const {
+      return by_id ? self_pos[p - p0] : self0 + (p - p0);
+    }
   };
 
   // One particle's query: its position and h^2.
@@ -581,8 +592,34 @@ class CellIndex {
   }
 
   struct BlockBuffer {
-    std::array<std::vector<Real>, Dim> x;
-    std::vector<std::uint32_t> id;
+    std::array<std::vector<Real>, Dim> x, x_sorted;
+    std::vector<std::uint32_t> id, self_pos;
+    std::vector<std::uint64_t> order;
+
+    // Reorders a filled block by particle index, so that every row found in it is ascending
+    // without a sort of its own: one sort per home cell instead of one per particle, which pays
+    // in dense cells (hundreds of particles) whose rows are long. `home` particles of the home
+    // cell start at blk.self0.
+    void sort_by_id(Block& blk, std::uint32_t home) {
+      const std::uint32_t n = blk.n;
+      order.resize(n);
+      for (std::uint32_t t = 0; t < n; ++t) order[t] = (std::uint64_t{id[t]} << 32) | t;
+      std::sort(order.begin(), order.end());
+      self_pos.resize(home);
+      for (int k = 0; k < Dim; ++k) x_sorted[k].resize(x[k].size());
+      for (std::uint32_t t = 0; t < n; ++t) {
+        const auto from = static_cast<std::uint32_t>(order[t]);
+        for (int k = 0; k < Dim; ++k) x_sorted[k][t] = x[k][from];
+        id[t] = static_cast<std::uint32_t>(order[t] >> 32);
+        if (from - blk.self0 < home) self_pos[from - blk.self0] = t;
+      }
+      for (int k = 0; k < Dim; ++k) {
+        std::swap(x[k], x_sorted[k]);
+        blk.x[k] = x[k].data();
+      }
+      blk.self_pos = self_pos.data();
+      blk.by_id = true;
+    }
 
     // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
     template <bool WithIds>
@@ -723,7 +760,9 @@ class CellIndex {
   // boundaries that depend only on the data; each chunk places its cursors by binary search at its
   // first cell, then moves them forward only. kernel(p, block) is called once per particle p (key
   // order) with the candidates its own support needs. Returns the distance tests.
-  template <bool WithIds, class Kernel>
+  // ById: blocks of at least kSortBlockMin candidates shared by a whole home cell are sorted by
+  // particle index (BlockBuffer::sort_by_id), for rows that must come out ascending.
+  template <bool WithIds, bool ById = false, class Kernel>
   std::uint64_t traverse(Kernel&& kernel) const {
     const std::size_t nc = cell_count();
     if (nc == 0) return 0;
@@ -786,6 +825,8 @@ class CellIndex {
               home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total);
               home_blk.self0 = block_pos(merged.data(), nm, start[u]);
               home_blk.p0 = start[u];
+              if constexpr (ById)
+                if (total >= kSortBlockMin) home_buf.sort_by_id(home_blk, start[u + 1] - start[u]);
             }
             gathered = true;
             local_tests += total - 1;
@@ -830,6 +871,7 @@ class CellIndex {
 
   static constexpr std::size_t kPad = 8;
   static constexpr std::uint32_t kRankSortMax = 96;
+  static constexpr std::uint32_t kSortBlockMin = 1024;
 
   int subdivision_ = 1;
   bool sorted_rows_ = true;

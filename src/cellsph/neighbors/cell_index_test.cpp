@@ -246,6 +246,24 @@ TEST(CellIndex, PairsWithinUlpsOfTheSupportMatchAllPairs) {
   EXPECT_EQ(via_visitor(ci, x).indices, ref.indices);
 }
 
+// Cells holding hundreds of particles: their shared candidate blocks (over 1024) are sorted by index
+// once, so that the long rows come out ascending without a sort each; the lists must not change.
+TEST(CellIndex, DenseCellsGiveAscendingRowsFromAnIndexSortedBlock) {
+  const auto x = point_sets::uniform_random<3, double>(3000, 0.05);  // a box about 0.7 wide
+  const std::vector<double> h(x.size(), 0.3);
+  const NeighborList ref = all_pairs<3, double>(x, h);
+  for (int threads : {1, 2}) {
+    ScopedThreads st(threads);
+    CellIndex<3, double> ci;
+    ci.build(x, h);
+    ASSERT_LE(ci.cell_count(), 27u);  // about 100+ particles per cell
+    NeighborList a;
+    ci.find_all(a);
+    EXPECT_EQ(a.offsets, ref.offsets);
+    EXPECT_EQ(a.indices, ref.indices);
+  }
+}
+
 TEST(CellIndex, WidensKeysWhenEq17DoesNotFit) {
   // 2^28 cells per axis in 2D: 58 bits of cell coordinates plus 9 index bits exceed 64, so the
   // packed key cannot hold it; the wide layout must take over and stay exact.
