@@ -291,8 +291,8 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   }
   // Floating bodies: bodies.csv, one row per body and frame (the probe log's format and resume).
   const bool floating = !sim.body_states().empty();
-  ProbeLog body_log(out / "bodies.csv", {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx",
-                                         "wy", "wz"});
+  ProbeLog body_log(out / "bodies.csv",
+                    {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"});
   if (resuming && floating) body_log.resume(double(sim.time()));
 
   // ---- Everything is valid: from here on the run writes.

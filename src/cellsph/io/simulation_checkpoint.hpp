@@ -3,8 +3,8 @@
 // reads it for --resume): the particles and the solver state are its fields, the simulated time and step
 // count its header, and its user blob holds the rest of the integrator state and the caller's own bytes:
 //
-//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data |
-//   (version 2:) u32 body count + per floating body its RigidBodyState (19 f64: x, q, v, w, a, alpha)
+//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data
+//   | (version 2:) u32 body count + per floating body its RigidBodyState (19 f64: x, q, v, w, a, alpha)
 //
 // Version 1 (no bodies) is still read: its scenes had no floating bodies.
 // Time and last dt are stored as double: exact for float and double runs, so a resume is bit for bit.

@@ -944,8 +944,12 @@ void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, Particle
     if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
     RigidBody body;
     body.density = e.required_number("density", -1e12, 1e12);
-    if (!(body.density > 0)) e.fail("density", "must be > 0 kg/m^3 (got " + json_value_text(e.json()["density"]) + ")");
+    if (!(body.density > 0))
+      e.fail("density", "must be > 0 kg/m^3 (got " + json_value_text(e.json()["density"]) + ")");
     const int layers = static_cast<int>(e.integer("layers", 2, 1, 10));
+    // As the walls' `weight`: "volume" (rest_density spacing^dim, right for a shell at least one support
+    // length thick) or "akinci" (psi_b from the body's own particles).
+    const bool weight_volume = e.choice("weight", "volume", {"akinci", "volume"}) == "volume";
     const std::size_t first = p.size();
     double center[3] = {0, 0, 0};
     if (e.has("box")) {
@@ -959,7 +963,8 @@ void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, Particle
       for (std::size_t a = 0; a < Dim; ++a) {
         if (n[a] < 2)
           e.fail("box", "is thinner than two particle spacings on axis " + std::to_string(a) + " (" +
-                            std::to_string(b.hi[a] - b.lo[a]) + " m, spacing " + std::to_string(spacing) + ")");
+                            std::to_string(b.hi[a] - b.lo[a]) + " m, spacing " + std::to_string(spacing) +
+                            ")");
         size[a] = b.hi[a] - b.lo[a];
         center[a] = 0.5 * (b.lo[a] + b.hi[a]);
       }
@@ -991,7 +996,8 @@ void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, Particle
         } else {
           geometry::TriangleMesh m;
           for (int c = 0; c < 8; ++c)
-            m.vertices.push_back({(c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]});
+            m.vertices.push_back(
+                {(c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]});
           m.triangles = {{4, 6, 2}, {4, 2, 0}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
                          {6, 7, 3}, {6, 3, 2}, {2, 3, 1}, {2, 1, 0}, {4, 5, 7}, {4, 7, 6}};
           return geometry::Shape::mesh(std::move(m), spacing);
@@ -1002,8 +1008,8 @@ void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, Particle
       auto shape = read_shape<Dim>(e, spacing, files);
       if (!shape) e.fail_here("give a shape: \"box\", \"sphere\", \"cylinder\" or \"mesh\"");
       const double depth = layers * spacing;
-      budget_shape<Dim>(budget, *shape, spacing, 0, 1.5 * shape->area() * depth / std::pow(spacing, Dim) + 8, br,
-                        std::to_string(k), "this body");
+      budget_shape<Dim>(budget, *shape, spacing, 0, 1.5 * shape->area() * depth / std::pow(spacing, Dim) + 8,
+                        br, std::to_string(k), "this body");
       for (const auto& x : geometry::sample(*shape, spacing, false, depth)) {
         Vec<Dim, Real> v;
         for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
@@ -1031,6 +1037,9 @@ void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, Particle
       regions.solid_shapes.push_back(std::move(*shape));
     }
     if (p.size() == first) e.fail_here("has no boundary particle at spacing " + std::to_string(spacing));
+    if (weight_volume)
+      for (std::size_t i = first; i < p.size(); ++i)
+        p.m[i] = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
     for (int a = 0; a < 3; ++a) body.initial.x[a] = center[a];
     const auto v = e.vector("velocity", Dim, std::vector<double>(Dim, 0.0));
     for (std::size_t a = 0; a < Dim; ++a) body.initial.v[a] = v[a];

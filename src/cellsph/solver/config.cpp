@@ -138,7 +138,8 @@ void SolverConfig<Dim, Real>::validate() const {
       bad("backend", backend_name(backend), "floating bodies run on the CPU only (solver.backend = cpu)");
     if (wall_model == WallModel::Dynamic)
       bad("boundary.model", "dynamic",
-          "floating bodies need akinci or adami walls (dynamic walls keep a wall-wall density of walls at rest)");
+          "floating bodies need akinci or adami walls (dynamic walls keep a wall-wall density of walls at "
+          "rest)");
     positive("rigid_bodies.contact_distance", rigid_bodies.contact_distance);
     non_negative("rigid_bodies.contact_frequency", rigid_bodies.contact_frequency);
     non_negative("rigid_bodies.contact_damping", rigid_bodies.contact_damping);

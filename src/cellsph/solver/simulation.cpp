@@ -230,8 +230,8 @@ void Simulation<Dim, Real>::advance_bodies(Real dt) {
   const auto& st = bodies_.states();
   for (std::size_t b = 0; b < st.size(); ++b) {
     bool finite = true;
-    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(st[b].x[a]) && std::isfinite(st[b].v[a]) &&
-                                         std::isfinite(st[b].w[a]);
+    for (int a = 0; a < 3; ++a)
+      finite = finite && std::isfinite(st[b].x[a]) && std::isfinite(st[b].v[a]) && std::isfinite(st[b].w[a]);
     if (!finite) {
       std::ostringstream os;
       os << "unstable at step " << steps_ << " (t = " << time_ << " s): floating body " << b

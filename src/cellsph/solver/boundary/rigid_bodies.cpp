@@ -32,7 +32,8 @@ void rotation_matrix(const double* q, double* R) {
 
 // The inverse of a symmetric positive definite 3x3 matrix (cofactors); false when singular.
 bool invert(const double* A, double* out) {
-  const double c00 = A[4] * A[8] - A[5] * A[7], c01 = A[5] * A[6] - A[3] * A[8], c02 = A[3] * A[7] - A[4] * A[6];
+  const double c00 = A[4] * A[8] - A[5] * A[7], c01 = A[5] * A[6] - A[3] * A[8],
+               c02 = A[3] * A[7] - A[4] * A[6];
   const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
   if (!(std::abs(det) > 0) || !std::isfinite(det)) return false;
   const double inv = 1 / det;
@@ -52,8 +53,8 @@ bool invert(const double* A, double* out) {
 
 template <int Dim, class Real>
 void RigidBodySystem<Dim, Real>::init(const RigidBodies& cfg, const std::vector<V>& x,
-                                      const std::vector<std::uint8_t>& kind, const std::vector<std::uint32_t>& id,
-                                      double sound_speed) {
+                                      const std::vector<std::uint8_t>& kind,
+                                      const std::vector<std::uint32_t>& id, double sound_speed) {
   cfg_ = &cfg;
   states_.clear();
   if (!cfg.any()) return;
@@ -69,7 +70,8 @@ void RigidBodySystem<Dim, Real>::init(const RigidBodies& cfg, const std::vector<
     const std::int32_t b = cfg.of_particle[i];
     if (b < 0) continue;
     if (kind[i] != static_cast<std::uint8_t>(ParticleKind::Boundary))
-      throw InputError("particles: fluid particle " + std::to_string(i) + " is given to body " + std::to_string(b));
+      throw InputError("particles: fluid particle " + std::to_string(i) + " is given to body " +
+                       std::to_string(b));
     const RigidBodyState& s0 = cfg.bodies[static_cast<std::size_t>(b)].initial;
     // The offset in the body frame: R(q0)^T (x - X0).
     double d[3] = {0, 0, 0}, R[9], r[3] = {0, 0, 0};
@@ -110,8 +112,8 @@ void RigidBodySystem<Dim, Real>::set_slots(const std::vector<std::uint32_t>& id,
 template <int Dim, class Real>
 void RigidBodySystem<Dim, Real>::set_states(std::vector<RigidBodyState> states, const std::string& source) {
   if (states.size() != states_.size())
-    throw InputError(source + ": holds the state of " + std::to_string(states.size()) + " bodies, the scene has " +
-                     std::to_string(states_.size()));
+    throw InputError(source + ": holds the state of " + std::to_string(states.size()) +
+                     " bodies, the scene has " + std::to_string(states_.size()));
   for (std::size_t b = 0; b < states.size(); ++b) {
     const RigidBodyState& s = states[b];
     bool finite = true;
@@ -167,7 +169,8 @@ void RigidBodySystem<Dim, Real>::advance(double dt, const V& g) {
       s.alpha[0] = s.alpha[1] = 0;
       s.alpha[2] = rhs[2] / I[8];
     } else {
-      if (!invert(I, Iinv)) Iinv[0] = Iinv[1] = Iinv[2] = Iinv[3] = Iinv[4] = Iinv[5] = Iinv[6] = Iinv[7] = Iinv[8] = 0;
+      if (!invert(I, Iinv))
+        Iinv[0] = Iinv[1] = Iinv[2] = Iinv[3] = Iinv[4] = Iinv[5] = Iinv[6] = Iinv[7] = Iinv[8] = 0;
       mul(Iinv, rhs, s.alpha);
     }
     for (int a = 0; a < 3; ++a) s.w[a] += dt * s.alpha[a];
@@ -189,8 +192,9 @@ void RigidBodySystem<Dim, Real>::advance(double dt, const V& g) {
 template <int Dim, class Real>
 void RigidBodySystem<Dim, Real>::place(std::vector<V>& x, std::vector<V>& v, std::vector<V>& wall_a) const {
   if (slot_.empty()) return;
-  run_pass(slot_.size(), BodyPlacePass<Dim, Real>{x.data(), v.data(), wall_a.empty() ? nullptr : wall_a.data(),
-                                                  slot_.data(), body_.data(), r0_.data(), states_.data()});
+  run_pass(slot_.size(),
+           BodyPlacePass<Dim, Real>{x.data(), v.data(), wall_a.empty() ? nullptr : wall_a.data(),
+                                    slot_.data(), body_.data(), r0_.data(), states_.data()});
 }
 
 template <int Dim, class Real>
@@ -230,8 +234,8 @@ void ball_mass_properties(int dim, double density, double radius, RigidBody& out
   }
 }
 
-void lattice_mass_properties(int dim, double density, double spacing, const std::vector<std::array<double, 3>>& pts,
-                             RigidBody& out, double* center) {
+void lattice_mass_properties(int dim, double density, double spacing,
+                             const std::vector<std::array<double, 3>>& pts, RigidBody& out, double* center) {
   const double cell = dim == 3 ? spacing * spacing * spacing : spacing * spacing;
   const double m = density * cell;
   double c[3] = {0, 0, 0};

@@ -223,8 +223,8 @@ class RigidBodySystem {
   // Each body particle's reaction force and contact force, summed per body in slot order (loads()).
   // `walls`: the fluid neighbours of every wall particle (gathered); `forces`: the WCSPH force pass.
   template <class ForcesPass>
-  void compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces, const std::uint32_t* wall_start,
-                     const std::uint32_t* wall_nbr);
+  void compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces,
+                     const std::uint32_t* wall_start, const std::uint32_t* wall_nbr);
   // One symplectic Euler step of dt under gravity g and loads().
   void advance(double dt, const V& g);
   // The body particles where the bodies are (BodyPlacePass).
@@ -256,23 +256,24 @@ void box_mass_properties(int dim, double density, const double* size, RigidBody&
 void ball_mass_properties(int dim, double density, double radius, RigidBody& out);
 // Of a solid given by lattice points (cells of edge `spacing`, Dim of them): mass and inertia summed over
 // the cells, each a point mass plus its own cell's inertia; `center` receives the centre of mass.
-void lattice_mass_properties(int dim, double density, double spacing, const std::vector<std::array<double, 3>>& pts,
-                             RigidBody& out, double* center);
+void lattice_mass_properties(int dim, double density, double spacing,
+                             const std::vector<std::array<double, 3>>& pts, RigidBody& out, double* center);
 
 template <int Dim, class Real>
 template <class ForcesPass>
 void RigidBodySystem<Dim, Real>::compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces,
-                                               const std::uint32_t* wall_start, const std::uint32_t* wall_nbr) {
+                                               const std::uint32_t* wall_start,
+                                               const std::uint32_t* wall_nbr) {
   f_.resize(slot_.size());
   // Per particle in parallel (each writes its own entry), then summed serially in slot order: the same
   // bits for any thread count.
-  run_pass(slot_.size(),
-           BodyReactionPass<Dim, Real, ForcesPass>{pv, forces, slot_.data(), wall_start, wall_nbr, f_.data()});
+  run_pass(slot_.size(), BodyReactionPass<Dim, Real, ForcesPass>{pv, forces, slot_.data(), wall_start,
+                                                                 wall_nbr, f_.data()});
   const RigidBodies& c = *cfg_;
   const double w = frequency_;
-  run_pass(slot_.size(), BodyContactPass<Dim, Real>{pv, slot_.data(), body_of_slot_.data(),
-                                                    mass_per_particle_.data(), c.contact_distance, w * w,
-                                                    2 * c.contact_damping * w, f_.data()});
+  run_pass(slot_.size(),
+           BodyContactPass<Dim, Real>{pv, slot_.data(), body_of_slot_.data(), mass_per_particle_.data(),
+                                      c.contact_distance, w * w, 2 * c.contact_damping * w, f_.data()});
   loads_.assign(states_.size(), RigidBodyLoad{});
   for (std::size_t k = 0; k < slot_.size(); ++k) {
     RigidBodyLoad& l = loads_[static_cast<std::size_t>(body_[k])];
