@@ -207,21 +207,20 @@ void Simulation<Dim, Real>::set_body_slots(bool place) {
   bodies_.set_slots(p_.id, boundary_, p_.size());
   if (!bodies_.any()) return;
   if (wall_a_.size() != p_.size()) wall_a_.assign(p_.size(), V{});
-  for (const std::uint32_t b : bodies_.slots())
-    search_h_[b] = static_cast<Real>(cfg_.rigid_bodies.contact_distance) + skin_;
+  // Their rows hold their fluid neighbours (within h: the reaction) and the walls they touch.
+  const Real radius = std::max(cfg_.support, static_cast<Real>(cfg_.rigid_bodies.contact_distance));
+  for (const std::uint32_t b : bodies_.slots()) search_h_[b] = radius + skin_;
   if (place) bodies_.place(p_.x, p_.v, wall_a_);
   lists_valid_ = false;
 }
 
-// The bodies' fluid and contact loads (boundary/rigid_bodies.hpp) from the walls' fluid rows (gathered
-// here for Akinci walls; the Adami pass gathered them) and the force pass's own wall term.
+// The bodies' fluid and contact loads (boundary/rigid_bodies.hpp) from their own rows and the force
+// pass's own wall term.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_body_loads() {
-  if (!wall_states_) gather_wall_neighbors(view(), fluid_, bodies_.slots(), walls_);
   const ParticleView<Dim, Real> pv = view();
-  with_wcsph_forces_pass(cfg_, pv, any_tension_, wall_states_, [&](const auto& pass) {
-    bodies_.compute_loads(pv, pass, walls_.start.data(), walls_.nbr.data());
-  });
+  with_wcsph_forces_pass(cfg_, pv, any_tension_, wall_states_,
+                         [&](const auto& pass) { bodies_.compute_loads(pv, pass); });
 }
 
 template <int Dim, class Real>

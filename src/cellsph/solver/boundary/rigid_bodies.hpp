@@ -86,24 +86,25 @@ CELLSPH_HD inline void rotate(const double* q, const double* r, double* out) {
 
 }  // namespace body_detail
 
-// Per body particle k (slot[k]): minus the sum over its fluid neighbours i (the walls' fluid rows,
-// boundary/wall_neighbors.hpp, ascending i) of the force i feels from it, forces.wall_pair: the
-// pressure and viscous terms of the wall model in use, the same expression the fluid's pass added.
+// Per body particle k (slot[k]): minus the sum over its fluid neighbours i of the force i feels from it,
+// forces.wall_pair: the pressure and viscous terms of the wall model in use, the same expression the
+// fluid's pass added. The neighbours: b's own candidate row (body particles are searched at h + skin)
+// cut with the fluid rows' own test, |x_i - x_b|^2 <= h_i^2 (verlet_rows.hpp), so exactly the pairs the
+// fluid's pass saw, in ascending i.
 template <int Dim, class Real, class ForcesPass>
 struct BodyReactionPass {
   ParticleView<Dim, Real> pv;
   ForcesPass forces;
   const std::uint32_t* slot;
-  const std::uint32_t* wall_start;
-  const std::uint32_t* wall_nbr;
   Vec<Dim, double>* out;
 
   CELLSPH_HD void operator()(std::size_t k) const {
     using V = Vec<Dim, Real>;
     const std::uint32_t b = slot[k];
     Vec<Dim, double> s{};
-    for (std::uint32_t e = wall_start[b]; e < wall_start[b + 1]; ++e) {
-      const std::uint32_t i = wall_nbr[e];
+    for (const auto* it = pv.candidates_begin(b); it != pv.candidates_end(b); ++it) {
+      const std::uint32_t i = *it;
+      if (!pv.is_fluid(i) || !(distance2(pv.x[i], pv.x[b]) <= pv.h[i] * pv.h[i])) continue;
       const V xib = pv.x[i] - pv.x[b];
       const Real r = norm(xib);
       const V g = forces.wg.gradW(xib);
@@ -220,11 +221,10 @@ class RigidBodySystem {
   // Replaces the states (a checkpoint's); InputError naming `source` when there are not as many as bodies
   // or one is not finite or its quaternion not of unit length.
   void set_states(std::vector<RigidBodyState> states, const std::string& source);
-  // Each body particle's reaction force and contact force, summed per body in slot order (loads()).
-  // `walls`: the fluid neighbours of every wall particle (gathered); `forces`: the WCSPH force pass.
+  // Each body particle's reaction force and contact force, summed per body in slot order (loads()), from
+  // the body particles' candidate rows; `forces`: the WCSPH force pass.
   template <class ForcesPass>
-  void compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces,
-                     const std::uint32_t* wall_start, const std::uint32_t* wall_nbr);
+  void compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces);
   // One symplectic Euler step of dt under gravity g and loads().
   void advance(double dt, const V& g);
   // The body particles where the bodies are (BodyPlacePass).
@@ -261,14 +261,11 @@ void lattice_mass_properties(int dim, double density, double spacing,
 
 template <int Dim, class Real>
 template <class ForcesPass>
-void RigidBodySystem<Dim, Real>::compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces,
-                                               const std::uint32_t* wall_start,
-                                               const std::uint32_t* wall_nbr) {
+void RigidBodySystem<Dim, Real>::compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces) {
   f_.resize(slot_.size());
   // Per particle in parallel (each writes its own entry), then summed serially in slot order: the same
   // bits for any thread count.
-  run_pass(slot_.size(), BodyReactionPass<Dim, Real, ForcesPass>{pv, forces, slot_.data(), wall_start,
-                                                                 wall_nbr, f_.data()});
+  run_pass(slot_.size(), BodyReactionPass<Dim, Real, ForcesPass>{pv, forces, slot_.data(), f_.data()});
   const RigidBodies& c = *cfg_;
   const double w = frequency_;
   run_pass(slot_.size(),
