@@ -253,7 +253,12 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   auto is_fluid = [&parts](std::size_t i) {
     return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid);
   };
-  ropt.visible = is_fluid;
+  // Pictures show the floating bodies' particles too (the frames hold the fluid only; bodies.csv the bodies).
+  const auto& body_of = sim.body_of_slot();
+  ropt.visible = [&parts, &body_of](std::size_t i) {
+    return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) ||
+           (i < body_of.size() && body_of[i] >= 0);
+  };
   RenderBox rbox;
   rbox.lo = scene.view_lo;
   rbox.hi = scene.view_hi;

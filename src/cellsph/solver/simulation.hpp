@@ -138,6 +138,8 @@ class Simulation {
   // `source` when they do not fit the scene's bodies).
   [[nodiscard]] const std::vector<RigidBodyState>& body_states() const { return bodies_.states(); }
   [[nodiscard]] const std::vector<RigidBodyLoad>& body_loads() const { return bodies_.loads(); }
+  // Per particle slot (particles()' order), its body or -1; empty without bodies.
+  [[nodiscard]] const std::vector<std::int32_t>& body_of_slot() const { return bodies_.body_of_slot(); }
   void restore_bodies(std::vector<RigidBodyState> states, const std::string& source);
 
   // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
