@@ -253,7 +253,12 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   auto is_fluid = [&parts](std::size_t i) {
     return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid);
   };
-  ropt.visible = is_fluid;
+  // Pictures show the floating bodies' particles too (the frames hold the fluid only; bodies.csv the bodies).
+  const auto& body_of = sim.body_of_slot();
+  ropt.visible = [&parts, &body_of](std::size_t i) {
+    return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) ||
+           (i < body_of.size() && body_of[i] >= 0);
+  };
   RenderBox rbox;
   rbox.lo = scene.view_lo;
   rbox.hi = scene.view_hi;
@@ -289,6 +294,11 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     probe_log.resume(double(sim.time()));
     while (probes_due()) ++next_probe;
   }
+  // Floating bodies: bodies.csv, one row per body and frame (the probe log's format and resume).
+  const bool floating = !sim.body_states().empty();
+  ProbeLog body_log(out / "bodies.csv",
+                    {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"});
+  if (resuming && floating) body_log.resume(double(sim.time()));
 
   // ---- Everything is valid: from here on the run writes.
   if (g_stop_signal) {
@@ -315,7 +325,8 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     while (probes_due()) ++next_probe;
   };
   auto write_checkpoint = [&] {
-    if (probing) probe_log.flush();  // every row up to the checkpoint's time is on disk first
+    if (probing) probe_log.flush();
+    if (floating) body_log.flush();  // every row up to the checkpoint's time is on disk first
     write_simulation_checkpoint(sim, loop.encode(), ckpt_path);
   };
   auto write_frame = [&] {
@@ -326,6 +337,15 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
       render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
     if (opt.surface) write_surfaces(sim.particles(), sopt, surface_dir, loop.next_frame);
     if (probing) probe_log.flush();
+    if (floating) {
+      const auto& st = sim.body_states();
+      for (std::size_t b = 0; b < st.size(); ++b) {
+        const auto& s = st[b];
+        body_log.add(t, {double(b), s.x[0], s.x[1], s.x[2], s.q[0], s.q[1], s.q[2], s.q[3], s.v[0], s.v[1],
+                         s.v[2], s.w[0], s.w[1], s.w[2]});
+      }
+      body_log.flush();
+    }
     ++loop.next_frame;
     if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0)
       write_checkpoint();

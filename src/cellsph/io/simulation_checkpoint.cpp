@@ -64,6 +64,9 @@ void write_simulation_checkpoint(const Simulation<Dim, Real>& sim, std::string_v
   put(info.user, static_cast<std::uint8_t>(st.leapfrog_started));
   put(info.user, static_cast<std::uint64_t>(extra.size()));
   info.user.append(extra);
+  // Version 2: the floating bodies' states.
+  put(info.user, static_cast<std::uint32_t>(sim.body_states().size()));
+  for (const RigidBodyState& b : sim.body_states()) put(info.user, b);
   write_checkpoint(sim.particles(), sim.solver_state(), info, path);
 }
 
@@ -72,15 +75,16 @@ namespace {
 // The blob of `info` (see the header): the integrator state and the caller's bytes.
 template <class Real>
 std::pair<IntegratorState<Real>, std::string> parse_blob(const std::filesystem::path& path,
-                                                         const CheckpointInfo& info) {
+                                                         const CheckpointInfo& info,
+                                                         std::vector<RigidBodyState>* bodies = nullptr) {
   BlobReader r(path, info.user);
   if (info.user.size() < sizeof kBlobMagic ||
       std::memcmp(info.user.data(), kBlobMagic, sizeof kBlobMagic) != 0)
     r.fail("missing (the file was not written by a simulation)");
   r.bytes(sizeof kBlobMagic, "the magic");
   const auto version = r.get<std::uint32_t>("the version");
-  if (version != kSimulationBlobVersion)
-    r.fail("version " + std::to_string(version) + " is not supported (this build reads " +
+  if (version != kSimulationBlobVersion && version != 1)
+    r.fail("version " + std::to_string(version) + " is not supported (this build reads 1 to " +
            std::to_string(kSimulationBlobVersion) + ")");
   IntegratorState<Real> st;
   st.time = static_cast<Real>(info.time);
@@ -91,6 +95,14 @@ std::pair<IntegratorState<Real>, std::string> parse_blob(const std::filesystem::
   st.leapfrog_started = started != 0;
   const auto n = r.get<std::uint64_t>("the caller data length");
   std::string extra(r.bytes(static_cast<std::size_t>(n), "the caller data"));
+  if (version >= 2) {
+    const auto count = r.get<std::uint32_t>("the body count");
+    if (count > r.left() / sizeof(RigidBodyState))
+      r.fail("holds " + std::to_string(count) + " bodies in " + std::to_string(r.left()) + " bytes");
+    std::vector<RigidBodyState> states(count);
+    for (auto& b : states) b = r.get<RigidBodyState>("a body's state");
+    if (bodies) *bodies = std::move(states);
+  }
   if (r.left()) r.fail(std::to_string(r.left()) + " unexpected bytes at the end");
   return {st, std::move(extra)};
 }
@@ -108,8 +120,15 @@ std::string read_simulation_checkpoint(const std::filesystem::path& path, Simula
   Particles<Dim, Real> particles;
   SolverState<Dim, Real> solver;
   const CheckpointInfo info = read_checkpoint(path, particles, solver);
-  auto [st, extra] = parse_blob<Real>(path, info);
-  sim.restore(std::move(particles), st, "checkpoint '" + path.string() + "'", std::move(solver));
+  std::vector<RigidBodyState> bodies;
+  auto [st, extra] = parse_blob<Real>(path, info, &bodies);
+  const std::string source = "checkpoint '" + path.string() + "'";
+  // Checked before anything is restored (set_states checks the values again).
+  if (bodies.size() != sim.body_states().size())
+    throw InputError(source + ": holds the state of " + std::to_string(bodies.size()) +
+                     " floating bodies, the scene has " + std::to_string(sim.body_states().size()));
+  sim.restore(std::move(particles), st, source, std::move(solver));
+  if (!bodies.empty()) sim.restore_bodies(std::move(bodies), source);
   return extra;
 }
 

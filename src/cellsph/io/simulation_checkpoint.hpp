@@ -4,7 +4,9 @@
 // count its header, and its user blob holds the rest of the integrator state and the caller's own bytes:
 //
 //   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data
+//   | (version 2:) u32 body count + per floating body its RigidBodyState (19 f64: x, q, v, w, a, alpha)
 //
+// Version 1 (no bodies) is still read: its scenes had no floating bodies.
 // Time and last dt are stored as double: exact for float and double runs, so a resume is bit for bit.
 #include <filesystem>
 #include <string>
@@ -14,7 +16,7 @@
 
 namespace cellsph {
 
-inline constexpr std::uint32_t kSimulationBlobVersion = 1;
+inline constexpr std::uint32_t kSimulationBlobVersion = 2;
 
 // Writes atomically. `extra`: bytes the caller wants back on resume (the app's frame counter).
 template <int Dim, class Real>

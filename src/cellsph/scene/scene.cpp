@@ -919,6 +919,143 @@ Regions<Dim> read_boundary(JsonReader& r, double spacing, const MeshFiles& files
   return regions;
 }
 
+// --- floating bodies (/bodies, /body_contact) ---------------------------------------------------
+// Each body: a box ("box": {min, max}) or a shape (read_shape: "sphere", "cylinder", "mesh"), `layers`
+// layers of boundary particles on the lattice inside its surface, its mass and inertia from `density`
+// (analytic for a box and a sphere; from the shape's inside lattice, scaled to its exact volume, for a
+// cylinder or a mesh), its initial velocity and angular velocity (boundary/rigid_bodies.hpp).
+template <int Dim, class Real>
+void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, ParticleBudget& budget,
+                 Particles<Dim, Real>& p, Regions<Dim>& regions, SolverConfig<Dim, Real>& cfg) {
+  auto& rb = cfg.rigid_bodies;
+  rb.contact_distance = spacing;
+  if (r.has("body_contact")) {
+    auto cr = r.child("body_contact");
+    rb.contact_distance = cr.number("distance", spacing, 0, 1e9);
+    if (!(rb.contact_distance > 0)) cr.fail("distance", "must be > 0");
+    rb.contact_frequency = cr.number("frequency", 0, 0, 1e12);
+    rb.contact_damping = cr.number("damping", 1, 0, 1e6);
+    cr.finish();
+  }
+  if (!r.has("bodies")) return;
+  auto br = r.child("bodies");
+  for (std::size_t k = 0; k < br.array_size(); ++k) {
+    auto e = br.element(k);
+    if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+    RigidBody body;
+    body.density = e.required_number("density", -1e12, 1e12);
+    if (!(body.density > 0))
+      e.fail("density", "must be > 0 kg/m^3 (got " + json_value_text(e.json()["density"]) + ")");
+    const int layers = static_cast<int>(e.integer("layers", 2, 1, 10));
+    // As the walls' `weight`: "volume" (rest_density spacing^dim, right for a shell at least one support
+    // length thick) or "akinci" (psi_b from the body's own particles).
+    const bool weight_volume = e.choice("weight", "volume", {"akinci", "volume"}) == "volume";
+    const std::size_t first = p.size();
+    double center[3] = {0, 0, 0};
+    if (e.has("box")) {
+      for (const char* other : {"min", "mesh", "sphere", "cylinder"})
+        if (e.has(other)) e.fail_here("give one shape: \"box\", \"sphere\", \"cylinder\" or \"mesh\"");
+      auto bx = e.child("box");
+      const auto b = read_box<Dim>(bx);
+      bx.finish();
+      const auto n = cells_of<Dim>(b, spacing);
+      double size[3] = {0, 0, 0};
+      for (std::size_t a = 0; a < Dim; ++a) {
+        if (n[a] < 2)
+          e.fail("box", "is thinner than two particle spacings on axis " + std::to_string(a) + " (" +
+                            std::to_string(b.hi[a] - b.lo[a]) + " m, spacing " + std::to_string(spacing) +
+                            ")");
+        size[a] = b.hi[a] - b.lo[a];
+        center[a] = 0.5 * (b.lo[a] + b.hi[a]);
+      }
+      budget.take(double(n[0]) * double(n[1]) * double(n[2]), br, std::to_string(k), "this body");
+      for (long kk = 0; kk < n[2]; ++kk)
+        for (long jj = 0; jj < n[1]; ++jj)
+          for (long ii = 0; ii < n[0]; ++ii) {
+            const long idx[3] = {ii, jj, kk};
+            bool shell = false;
+            Vec<Dim, Real> x;
+            for (std::size_t a = 0; a < Dim; ++a) {
+              shell = shell || std::min(idx[a], n[a] - 1 - idx[a]) < layers;
+              x[static_cast<int>(a)] = static_cast<Real>(b.lo[a] + (double(idx[a]) + 0.5) * spacing);
+            }
+            if (shell) add_particle(p, x, 0, ParticleKind::Boundary);
+          }
+      box_mass_properties(Dim, body.density, size, body);
+      body.shape = "box";
+      // The fluid keeps half a spacing from it as from a shape: in 2D the box is a cylinder's section,
+      // in 3D a closed mesh of its 12 triangles.
+      geometry::Shape solid = [&] {
+        if constexpr (Dim == 2) {
+          geometry::Cylinder cy;
+          cy.base = {center[0], b.lo[1], 0};
+          cy.axis = {0, 1, 0};
+          cy.radius = size[0] / 2;
+          cy.height = size[1];
+          return geometry::Shape::cylinder(cy, 2);
+        } else {
+          geometry::TriangleMesh m;
+          for (int c = 0; c < 8; ++c)
+            m.vertices.push_back(
+                {(c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]});
+          m.triangles = {{4, 6, 2}, {4, 2, 0}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
+                         {6, 7, 3}, {6, 3, 2}, {2, 3, 1}, {2, 1, 0}, {4, 5, 7}, {4, 7, 6}};
+          return geometry::Shape::mesh(std::move(m), spacing);
+        }
+      }();
+      regions.solid_shapes.push_back(std::move(solid));
+    } else {
+      auto shape = read_shape<Dim>(e, spacing, files);
+      if (!shape) e.fail_here("give a shape: \"box\", \"sphere\", \"cylinder\" or \"mesh\"");
+      const double depth = layers * spacing;
+      budget_shape<Dim>(budget, *shape, spacing, 0, 1.5 * shape->area() * depth / std::pow(spacing, Dim) + 8,
+                        br, std::to_string(k), "this body");
+      for (const auto& x : geometry::sample(*shape, spacing, false, depth)) {
+        Vec<Dim, Real> v;
+        for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
+        add_particle(p, v, 0, ParticleKind::Boundary);
+      }
+      if (e.has("sphere")) {
+        const auto& c = e.json()["sphere"]["center"];
+        for (std::size_t a = 0; a < Dim; ++a) center[a] = c[a].get<double>();
+        ball_mass_properties(Dim, body.density, e.json()["sphere"]["radius"].get<double>(), body);
+        body.shape = "sphere";
+      } else {
+        // The inside lattice's mass and inertia, scaled to the exact volume.
+        const auto inside = geometry::sample(*shape, spacing, false, HUGE_VAL);
+        std::vector<std::array<double, 3>> pts(inside.begin(), inside.end());
+        if (pts.empty()) e.fail_here("holds no lattice site of spacing " + std::to_string(spacing));
+        lattice_mass_properties(Dim, body.density, spacing, pts, body, center);
+        const double scale = body.density * shape->volume() / body.mass;
+        body.mass *= scale;
+        for (double& v : body.inertia) v *= scale;
+        body.shape = e.has("mesh") ? "mesh" : "cylinder";
+      }
+      regions.shape_keys.push_back(e.path());
+      regions.all_shapes.push_back(*shape);
+      regions.shape_margins.push_back(0);
+      regions.solid_shapes.push_back(std::move(*shape));
+    }
+    if (p.size() == first) e.fail_here("has no boundary particle at spacing " + std::to_string(spacing));
+    if (weight_volume)
+      for (std::size_t i = first; i < p.size(); ++i)
+        p.m[i] = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
+    for (int a = 0; a < 3; ++a) body.initial.x[a] = center[a];
+    const auto v = e.vector("velocity", Dim, std::vector<double>(Dim, 0.0));
+    for (std::size_t a = 0; a < Dim; ++a) body.initial.v[a] = v[a];
+    if (Dim == 2) {
+      body.initial.w[2] = e.number("angular_velocity", 0, -1e6, 1e6);
+    } else {
+      const auto w = e.vector("angular_velocity", 3, {0, 0, 0});
+      for (std::size_t a = 0; a < 3; ++a) body.initial.w[a] = w[a];
+    }
+    e.finish();
+    rb.of_particle.resize(first, -1);
+    rb.of_particle.resize(p.size(), static_cast<std::int32_t>(rb.bodies.size()));
+    rb.bodies.push_back(std::move(body));
+  }
+}
+
 template <int Dim, class Real>
 void read_domain(JsonReader& r, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regions) {
   if (!r.has("domain")) return;
@@ -1305,11 +1442,13 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   budget.take(count_fluid_particles<Dim>(j, spacing), r, "fluids", "the fluid blocks");
   const MeshFiles files = mesh_files_of(source);
   Regions<Dim> regions = read_boundary(r, spacing, files, cfg, budget, s.particles);
+  read_bodies(r, spacing, files, budget, s.particles, regions, cfg);
   read_domain(r, cfg, regions);
   const FluidBlocks<Dim> fluids = read_fluids(r, spacing, files, phases, regions, budget, s.particles);
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
   // Moving obstacles: every particle after the last moving one (fluid, other walls) is at rest.
   if (cfg.wall_motion.any()) cfg.wall_motion.of_particle.resize(s.particles.size(), -1);
+  if (cfg.rigid_bodies.any()) cfg.rigid_bodies.of_particle.resize(s.particles.size(), -1);
 
   read_output<Dim>(r, s.output);
   read_probes<Dim>(r, s.probes, s.probes_every);

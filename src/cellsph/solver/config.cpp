@@ -128,6 +128,31 @@ void SolverConfig<Dim, Real>::validate() const {
       bad("wall_motion.of_particle", m, "is not -1 or a motion's index");
   if (wall_motion.any() && time.mode == TimeStepping::PerParticle)
     bad("time.mode", "per-particle", "moving walls need global time steps (fixed or courant)");
+  if (rigid_bodies.any()) {
+    if (model != Model::Wcsph)
+      bad("model", model_name(model),
+          "floating bodies need the WCSPH model (solver.model = wcsph): their force is its wall term");
+    if (time.mode == TimeStepping::PerParticle)
+      bad("time.mode", "per-particle", "floating bodies need global time steps (fixed or courant)");
+    if (backend != Backend::Cpu)
+      bad("backend", backend_name(backend), "floating bodies run on the CPU only (solver.backend = cpu)");
+    if (wall_model == WallModel::Dynamic)
+      bad("boundary.model", "dynamic",
+          "floating bodies need akinci or adami walls (dynamic walls keep a wall-wall density of walls at "
+          "rest)");
+    positive("rigid_bodies.contact_distance", rigid_bodies.contact_distance);
+    non_negative("rigid_bodies.contact_frequency", rigid_bodies.contact_frequency);
+    non_negative("rigid_bodies.contact_damping", rigid_bodies.contact_damping);
+    for (std::size_t k = 0; k < rigid_bodies.bodies.size(); ++k) {
+      const RigidBody& b = rigid_bodies.bodies[k];
+      const std::string key = "rigid_bodies[" + std::to_string(k) + "].";
+      positive(key + "mass", b.mass);
+      for (int a = 0; a < 3; ++a) positive(key + "inertia", b.inertia[4 * a]);
+    }
+    for (const std::int32_t b : rigid_bodies.of_particle)
+      if (b < -1 || (b >= 0 && static_cast<std::size_t>(b) >= rigid_bodies.bodies.size()))
+        bad("rigid_bodies.of_particle", b, "is not -1 or a body's index");
+  }
 }
 
 std::string_view model_name(Model m) {

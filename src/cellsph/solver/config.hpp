@@ -12,6 +12,7 @@
 #include "cellsph/physics/eos.hpp"
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/solver/backend.hpp"
+#include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/boundary/wall_motion.hpp"
 
 namespace cellsph {
@@ -185,6 +186,9 @@ struct SolverConfig {
   // Moving walls (boundary/wall_motion.hpp; scene key boundary.obstacles[k].motion): the prescribed
   // motions and which boundary particle each moves. Empty: every wall at rest. CPU steps only.
   WallMotions wall_motion{};
+  // Floating bodies (boundary/rigid_bodies.hpp; scene key bodies): their mass, inertia and initial state
+  // and which boundary particle belongs to which. Empty: none. WCSPH with global steps on the CPU only.
+  RigidBodies rigid_bodies{};
   Real restitution = Real(0.2);
   Real friction = Real(0.1);
 

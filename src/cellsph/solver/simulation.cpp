@@ -127,6 +127,8 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
       motion_of_id_[p_.id[i]] = of[i];
     }
   }
+  // Floating bodies: each body particle's offset from its body's centre, kept by id.
+  bodies_.init(cfg_.rigid_bodies, p_.x, p_.kind, p_.id, static_cast<double>(reference_sound_speed(cfg_)));
 
   fluid_count_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -195,8 +197,55 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   init_boundary_weights();
   set_moving_slots();
   move_walls(time_);
+  set_body_slots(true);
   lists_valid_ = false;
   if (cfg_.backend != Backend::Cpu) use_backend(cfg_.backend);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::set_body_slots(bool place) {
+  bodies_.set_slots(p_.id, boundary_, p_.size());
+  if (!bodies_.any()) return;
+  if (wall_a_.size() != p_.size()) wall_a_.assign(p_.size(), V{});
+  // Their rows hold their fluid neighbours (within h: the reaction) and the walls they touch.
+  const Real radius = std::max(cfg_.support, static_cast<Real>(cfg_.rigid_bodies.contact_distance));
+  for (const std::uint32_t b : bodies_.slots()) search_h_[b] = radius + skin_;
+  if (place) bodies_.place(p_.x, p_.v, wall_a_);
+  lists_valid_ = false;
+}
+
+// The bodies' fluid and contact loads (boundary/rigid_bodies.hpp) from their own rows and the force
+// pass's own wall term.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::compute_body_loads() {
+  const ParticleView<Dim, Real> pv = view();
+  with_wcsph_forces_pass(cfg_, pv, any_tension_, wall_states_,
+                         [&](const auto& pass) { bodies_.compute_loads(pv, pass); });
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::advance_bodies(Real dt) {
+  bodies_.advance(static_cast<double>(dt), cfg_.gravity);
+  const auto& st = bodies_.states();
+  for (std::size_t b = 0; b < st.size(); ++b) {
+    bool finite = true;
+    for (int a = 0; a < 3; ++a)
+      finite = finite && std::isfinite(st[b].x[a]) && std::isfinite(st[b].v[a]) && std::isfinite(st[b].w[a]);
+    if (!finite) {
+      std::ostringstream os;
+      os << "unstable at step " << steps_ << " (t = " << time_ << " s): floating body " << b
+         << " has a non-finite state";
+      throw SimulationError(os.str());
+    }
+  }
+  bodies_.place(p_.x, p_.v, wall_a_);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::restore_bodies(std::vector<RigidBodyState> states, const std::string& source) {
+  bodies_.set_states(std::move(states), source);
+  bodies_.place(p_.x, p_.v, wall_a_);
+  lists_valid_ = false;
 }
 
 template <int Dim, class Real>
@@ -332,6 +381,7 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     const MaxDisplacementPass<Dim, Real> disp{view(), x_built_.data()};
     Real d2 = reduce_max(fluid_, MaxValue<Real>{}, disp).value;
     if (!moving_.empty()) d2 = std::max(d2, reduce_max(moving_, MaxValue<Real>{}, disp).value);
+    if (bodies_.any()) d2 = std::max(d2, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
     if (d2 <= limit * limit) return;
   }
@@ -569,6 +619,7 @@ void Simulation<Dim, Real>::step() {
     compute_forces_paper(fluid_, fluid_);
   else
     compute_forces_wcsph();
+  if (bodies_.any()) compute_body_loads();
   timings_.forces += sw.ms();
 
   sw.reset();
@@ -583,6 +634,7 @@ void Simulation<Dim, Real>::step() {
   last_dt_ = dt;
   ++steps_;
   move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
+  if (bodies_.any()) advance_bodies(dt);
   timings_.integration += sw.ms();
 }
 
@@ -740,6 +792,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
   // the file's fault, named as such (the Simulation is then not usable; the caller stops).
   set_moving_slots();
+  set_body_slots(false);  // their particles are the checkpoint's; restore_bodies sets their states
   if (cfg_.wall_model == WallModel::Dynamic) {
     // Moving walls: the fixed share is that of the initial positions, as at construction.
     for (std::size_t k = 0; k < moving_.size(); ++k) p_.x[moving_[k]] = moving_x0_[k];
@@ -771,6 +824,9 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
     return;
   }
   require_backend(b, "solver.backend");
+  if (bodies_.any())
+    throw InputError("solver.backend " + std::string(backend_name(b)) +
+                     ": floating bodies (bodies) run on the CPU backend only");
   if (const std::string why = device_step_unsupported(cfg_); !why.empty())
     throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
   sync_host();

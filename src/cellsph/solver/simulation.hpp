@@ -31,6 +31,7 @@
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
 #include "cellsph/solver/backend.hpp"
+#include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_stepper_base.hpp"
@@ -131,6 +132,16 @@ class Simulation {
   void restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state, const std::string& source,
                SolverState<Dim, Real> solver = {});
 
+  // Floating bodies (boundary/rigid_bodies.hpp): each body's state (centre, orientation, velocities) and
+  // the fluid and contact force and torque of the last step. A checkpoint holds the states
+  // (io/simulation_checkpoint.hpp); restore_bodies puts them back after restore() (InputError naming
+  // `source` when they do not fit the scene's bodies).
+  [[nodiscard]] const std::vector<RigidBodyState>& body_states() const { return bodies_.states(); }
+  [[nodiscard]] const std::vector<RigidBodyLoad>& body_loads() const { return bodies_.loads(); }
+  // Per particle slot (particles()' order), its body or -1; empty without bodies.
+  [[nodiscard]] const std::vector<std::int32_t>& body_of_slot() const { return bodies_.body_of_slot(); }
+  void restore_bodies(std::vector<RigidBodyState> states, const std::string& source);
+
   // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
   // fluid particle in every sub-step, as before the work sets existed. Results are bit-identical either
   // way (only the densities of particles no force reads differ: with the work sets they keep the value
@@ -182,6 +193,13 @@ class Simulation {
   // (move_walls: position, velocity, acceleration; a pure function of t and the initial position).
   void set_moving_slots();
   void move_walls(Real t);
+  // Floating bodies: their slots (from the ids) and their particles' search radius (the contact distance,
+  // so that their rows hold the walls they touch).
+  void set_body_slots(bool place);
+  // Their load from the step's forces, after the fluid's force pass; their step of dt (then their
+  // particles are placed; SimulationError when a state is not finite).
+  void compute_body_loads();
+  void advance_bodies(Real dt);
   void step_per_particle();
   void step_dfsph(Stopwatch& sw);
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
@@ -262,6 +280,8 @@ class Simulation {
   std::vector<V> moving_x0_;
   std::vector<std::int32_t> moving_motion_;
   std::vector<V> wall_a_;
+  // Floating bodies (config rigid_bodies): their particles' slots, offsets, states and loads.
+  RigidBodySystem<Dim, Real> bodies_;
 
   // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
   // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.

@@ -41,6 +41,40 @@ struct WcsphForcesPass {
   bool no_slip;
   bool clamp_negative;  // the EOS's, for Akinci walls' mirrored pressure
 
+  // The force fluid particle i feels from wall particle j (x_ij = x_i - x_j, r = |x_ij|, g = grad W(x_ij)),
+  // added to fp (pressure) and fnp (the rest). Written once: the fluid's force pass adds it to i, the
+  // floating bodies' force pass (boundary/rigid_bodies.hpp) subtracts it from j with the same bits.
+  CELLSPH_HD void wall_pair(std::size_t i, std::uint32_t j, const Vec<Dim, Real>& xij, Real r,
+                            const Vec<Dim, Real>& g, Vec<Dim, Real>& fp, Vec<Dim, Real>& fnp) const {
+    using V = Vec<Dim, Real>;
+    const Real mi = pv.m[i], rhoi = pv.rho[i], pi = pv.p[i], mui = pv.mu[i];
+    const Real vol_i = mi / rhoi;
+    const V vel_i = pv.v[i];
+    const bool laminar = mui > 0;
+    if (wall_states) {
+      // Adami / dynamic walls: the fluid pair terms with the wall's pressure, density and velocity
+      // (boundary/adami2012.hpp, boundary/dynamic_crespo2007.hpp); the laminar viscosity takes i's mu
+      // and the wall's no-slip velocity, the artificial one the wall's own (its prescribed velocity).
+      fp += symmetric_pressure_force(g, mi, pv.m[j], pv.prho2[i], pv.prho2[j]);
+      if (no_slip && laminar)
+        fnp += morris_viscosity_force(V(vel_i - pv.wall_v[j]), g, xij, r, vol_i, pv.vol[j], mui, mui, eta2);
+      if (av_walls && alpha_c0_h > 0)
+        fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, pv.rho[j],
+                                          alpha_c0_h, eta2);
+    } else {
+      // Akinci walls (boundary/akinci2012.hpp): mirrored density, extrapolated pressure; no slip:
+      // the laminar operator against the wall particle's velocity (0 at rest, boundary/wall_motion.hpp)
+      // with volume psi_b / rho_i and i's mu.
+      const Real pb = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
+      fp += boundary_pressure_force(g, mi, rhoi, pi, pb, pv.m[j]);
+      if (no_slip && laminar)
+        fnp += morris_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
+      if (av_walls && alpha_c0_h > 0)
+        fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, rhoi, alpha_c0_h,
+                                          eta2);
+    }
+  }
+
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
     const Real vol_i = pv.m[i] / pv.rho[i];
@@ -48,7 +82,7 @@ struct WcsphForcesPass {
     V fp{};
     ColorField<Dim, Real> cf;
     cf.lap = vol_i * lap_self;
-    const Real mi = pv.m[i], rhoi = pv.rho[i], pi = pv.p[i], mui = pv.mu[i];
+    const Real mi = pv.m[i], rhoi = pv.rho[i], mui = pv.mu[i];
     const V vel_i = pv.v[i];
     const Real prho2_i = pv.prho2[i];
     const bool laminar = mui > 0;
@@ -65,28 +99,9 @@ struct WcsphForcesPass {
           fnp += artificial_viscosity_force(vij, g, xij, r, mi, pv.m[j], rhoi, pv.rho[j], alpha_c0_h, eta2);
         fp += symmetric_pressure_force(g, mi, pv.m[j], prho2_i, pv.prho2[j]);
         if (any_tension) accumulate_color(cf, xij, r, pv.vol[j], Real(1), wc);
-      } else if (wall_states) {
-        // Adami / dynamic walls: the fluid pair terms with the wall's pressure, density and velocity
-        // (boundary/adami2012.hpp, boundary/dynamic_crespo2007.hpp); the laminar viscosity takes i's mu
-        // and the wall's no-slip velocity, the artificial one the wall's own (its prescribed velocity).
-        fp += symmetric_pressure_force(g, mi, pv.m[j], prho2_i, pv.prho2[j]);
-        if (no_slip && laminar)
-          fnp += morris_viscosity_force(V(vel_i - pv.wall_v[j]), g, xij, r, vol_i, pv.vol[j], mui, mui, eta2);
-        if (av_walls && alpha_c0_h > 0)
-          fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, pv.rho[j],
-                                            alpha_c0_h, eta2);
-        if (any_tension) accumulate_color(cf, xij, r, pv.m[j] / rhoi, Real(1), wc);
       } else {
-        // Akinci walls (boundary/akinci2012.hpp): mirrored density, extrapolated pressure; no slip:
-        // the laminar operator against the wall particle's velocity (0 at rest, boundary/wall_motion.hpp)
-        // with volume psi_b / rho_i and i's mu.
-        const Real pb = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
-        fp += boundary_pressure_force(g, mi, rhoi, pi, pb, pv.m[j]);
-        if (no_slip && laminar)
-          fnp += morris_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
-        if (av_walls && alpha_c0_h > 0)
-          fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, rhoi,
-                                            alpha_c0_h, eta2);
+        // Walls: wall_pair (the floating bodies' reaction reads the same expression).
+        wall_pair(i, j, xij, r, g, fp, fnp);
         if (any_tension) accumulate_color(cf, xij, r, pv.m[j] / rhoi, Real(1), wc);
       }
     }
@@ -139,20 +154,27 @@ struct WcsphDriftPass {
   CELLSPH_HD void operator()(std::size_t i) const { pv.x[i] += pv.v[i] * dt; }
 };
 
-// The forces of `set` (the fluid), after the densities and the wall states.
-template <int Dim, class Real, class Set>
-void wcsph_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set,
-                  bool any_tension, bool wall_states) {
+// The force pass of this config, handed to `fn` (wcsph_forces runs it; the floating bodies call its
+// wall_pair).
+template <int Dim, class Real, class F>
+void with_wcsph_forces_pass(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
+                            bool any_tension, bool wall_states, F&& fn) {
   const Poly6Kernel<Dim, Real> wc(cfg.support);
   const Real h = smoothing_length(cfg);
   const Real alpha_c0_h = cfg.artificial_viscosity.alpha * reference_sound_speed(cfg) * h;
   with_kernel<Dim, Real>(cfg.pressure_kernel, cfg.support, [&](const auto wg) {
     using K = std::remove_cvref_t<decltype(wg)>;
-    run_pass(set,
-             WcsphForcesPass<Dim, Real, K>{pv, wg, wc, cfg.gravity, wc.laplacian(0), Real(0.01) * h * h,
-                                           cfg.tension_threshold, alpha_c0_h, cfg.artificial_viscosity.walls,
-                                           any_tension, wall_states, cfg.no_slip, cfg.eos.clamp_negative});
+    fn(WcsphForcesPass<Dim, Real, K>{pv, wg, wc, cfg.gravity, wc.laplacian(0), Real(0.01) * h * h,
+                                     cfg.tension_threshold, alpha_c0_h, cfg.artificial_viscosity.walls,
+                                     any_tension, wall_states, cfg.no_slip, cfg.eos.clamp_negative});
   });
+}
+
+// The forces of `set` (the fluid), after the densities and the wall states.
+template <int Dim, class Real, class Set>
+void wcsph_forces(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& set,
+                  bool any_tension, bool wall_states) {
+  with_wcsph_forces_pass(cfg, pv, any_tension, wall_states, [&](const auto& pass) { run_pass(set, pass); });
 }
 
 }  // namespace cellsph
