@@ -16,6 +16,7 @@
 #include "cellsph/io/checkpoint.hpp"
 #include "cellsph/io/io_test_util.hpp"
 #include "cellsph/solver/initial.hpp"
+#include "cellsph/solver/solver_test_util.hpp"
 
 namespace cellsph {
 namespace {
@@ -131,17 +132,7 @@ void dfsph_resume_is_bit_identical() {
   test::TempDir dir("sim_ckpt_dfsph");
   const Real s = Real(0.02);
   const int nx = Dim == 2 ? 8 : 4;
-  SolverConfig<Dim, Real> cfg;
-  cfg.model = Model::Dfsph;
-  cfg.search.method = Method::CellIndex;
-  cfg.density_kernel = KernelKind::CubicSpline;
-  cfg.pressure_kernel = KernelKind::CubicSpline;
-  cfg.support = 2 * s;
-  cfg.phases[0].rest_density = 1000;
-  cfg.phases[0].mass = Real(1000 * std::pow(double(s), Dim));
-  cfg.phases[0].viscosity = Real(0.001);
-  cfg.time.mode = TimeStepping::Courant;
-  cfg.time.dt_max = Real(2e-3);
+  SolverConfig<Dim, Real> cfg = test::dfsph_water<Dim, Real>(s, Real(0.001), Real(2e-3));
   cfg.reorder_every = 5;
   V lo{}, hi{}, box{};
   for (int a = 0; a < Dim; ++a) {

@@ -19,24 +19,7 @@
 namespace cellsph {
 namespace {
 
-// Water at spacing s: cubic spline, h = 2 s, Akinci walls, Courant steps at most dt_max.
-template <int Dim, class Real>
-SolverConfig<Dim, Real> dfsph_water(Real s, Real mu, Real dt_max) {
-  SolverConfig<Dim, Real> cfg;
-  cfg.model = Model::Dfsph;
-  cfg.search.method = Method::CellIndex;
-  cfg.density_kernel = KernelKind::CubicSpline;
-  cfg.pressure_kernel = KernelKind::CubicSpline;
-  cfg.support = 2 * s;
-  cfg.phases[0].rest_density = 1000;
-  cfg.phases[0].mass = Real(1000 * std::pow(double(s), Dim));
-  cfg.phases[0].viscosity = mu;
-  cfg.time.mode = TimeStepping::Courant;
-  cfg.time.courant = Real(0.4);
-  cfg.time.dt_max = dt_max;
-  cfg.no_slip = true;
-  return cfg;
-}
+using test::dfsph_water;
 
 using V2 = Vec<2, double>;
 

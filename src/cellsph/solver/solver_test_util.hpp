@@ -29,6 +29,25 @@ bool same_state(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
   return same;
 }
 
+// Water at spacing s: cubic spline, h = 2 s, Akinci walls, Courant steps at most dt_max.
+template <int Dim, class Real>
+SolverConfig<Dim, Real> dfsph_water(Real s, Real mu, Real dt_max) {
+  SolverConfig<Dim, Real> cfg;
+  cfg.model = Model::Dfsph;
+  cfg.search.method = Method::CellIndex;
+  cfg.density_kernel = KernelKind::CubicSpline;
+  cfg.pressure_kernel = KernelKind::CubicSpline;
+  cfg.support = 2 * s;
+  cfg.phases[0].rest_density = 1000;
+  cfg.phases[0].mass = Real(1000 * std::pow(double(s), Dim));
+  cfg.phases[0].viscosity = mu;
+  cfg.time.mode = TimeStepping::Courant;
+  cfg.time.courant = Real(0.4);
+  cfg.time.dt_max = dt_max;
+  cfg.no_slip = true;
+  return cfg;
+}
+
 // 2D WCSPH water as the dam-break scenes set it up: cubic kernels, h = 2 spacings, ratio EOS with sound
 // speed c, clamped negative pressure, the artificial viscosity mu = rho0 alpha h c / (2 (d + 2)) with
 // alpha = 0.02, Courant steps.
