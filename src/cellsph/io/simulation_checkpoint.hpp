@@ -3,8 +3,12 @@
 // reads it for --resume): the particles and the solver state are its fields, the simulated time and step
 // count its header, and its user blob holds the rest of the integrator state and the caller's own bytes:
 //
-//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data
+//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started |
+//   (version 2: u64 next particle id | u32 emitters e | e x f64 emitter advance) | u64 n + n bytes caller
+//   data
 //
+// Version 2 adds the state of emitters (solver/emitters.hpp); version 1 files still read (no emitters ran:
+// the next id follows the largest id, every emitter starts as at t = 0).
 // Time and last dt are stored as double: exact for float and double runs, so a resume is bit for bit.
 #include <filesystem>
 #include <string>
@@ -14,7 +18,7 @@
 
 namespace cellsph {
 
-inline constexpr std::uint32_t kSimulationBlobVersion = 1;
+inline constexpr std::uint32_t kSimulationBlobVersion = 2;
 
 // Writes atomically. `extra`: bytes the caller wants back on resume (the app's frame counter).
 template <int Dim, class Real>

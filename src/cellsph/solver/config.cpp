@@ -128,6 +128,10 @@ void SolverConfig<Dim, Real>::validate() const {
       bad("wall_motion.of_particle", m, "is not -1 or a motion's index");
   if (wall_motion.any() && time.mode == TimeStepping::PerParticle)
     bad("time.mode", "per-particle", "moving walls need global time steps (fixed or courant)");
+  if (const std::string err = inflow_config_error(inflow, Dim, phases.size()); !err.empty())
+    throw InputError(err);
+  if (inflow.any() && time.mode == TimeStepping::PerParticle)
+    bad("time.mode", "per-particle", "emitters and sinks need global time steps (fixed or courant)");
 }
 
 std::string_view model_name(Model m) {

@@ -13,6 +13,7 @@
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/solver/backend.hpp"
 #include "cellsph/solver/boundary/wall_motion.hpp"
+#include "cellsph/solver/emitters.hpp"
 
 namespace cellsph {
 
@@ -185,6 +186,9 @@ struct SolverConfig {
   // Moving walls (boundary/wall_motion.hpp; scene key boundary.obstacles[k].motion): the prescribed
   // motions and which boundary particle each moves. Empty: every wall at rest. CPU steps only.
   WallMotions wall_motion{};
+  // Inflow and outflow (emitters.hpp; scene keys emitters, sinks): particle counts change during the run.
+  // CPU, global steps only.
+  Inflow inflow{};
   Real restitution = Real(0.2);
   Real friction = Real(0.1);
 
