@@ -1,5 +1,6 @@
 #include "cellsph/scene/inflow_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -13,8 +14,8 @@ std::string given(const JsonReader& e, const char* key) {
   return json_value_text(e.json()[key]);
 }
 
-void read_emitter(JsonReader& e, int dim, const std::function<std::int32_t(JsonReader&)>& phase_of,
-                  Emitter& em) {
+void read_emitter(JsonReader& e, int dim, double spacing,
+                  const std::function<std::int32_t(JsonReader&)>& phase_of, Emitter& em) {
   const auto d = static_cast<std::size_t>(dim);
   em.shape = e.choice("shape", "box", {"box", "disc"}) == "disc" ? EmitterShape::Disc : EmitterShape::Box;
   const auto c = e.required_vector("center", d);
@@ -38,6 +39,15 @@ void read_emitter(JsonReader& e, int dim, const std::function<std::int32_t(JsonR
     if (!(size[k] > 0)) e.fail("size", given(e, "size") + " must be > 0 (a length in m)");
     em.size[k] = size[k];
   }
+  // One layer's particles (emitters.hpp: floor(size / spacing) along each tangent), bounded before any
+  // is made: a layer of more than 10^7 is a typo, not an inlet.
+  double cells = 1;
+  for (std::size_t k = 0; k < (dim == 3 ? 2u : 1u); ++k)
+    cells *= std::max(1.0, std::floor(size[two ? k : 0] / spacing * (1 + 1e-9)));
+  if (cells > 1e7)
+    e.fail("size", given(e, "size") + " makes layers of " + json_value_text(nlohmann::json(cells)) +
+                       " particles at spacing " + json_value_text(nlohmann::json(spacing)) +
+                       " (at most 10^7)");
   em.velocity = e.required_number("velocity");
   if (!(em.velocity >= 0))
     e.fail("velocity", given(e, "velocity") +
@@ -74,7 +84,7 @@ void read_inflow(JsonReader& r, int dim, double spacing,
     for (std::size_t k = 0; k < er.array_size(); ++k) {
       auto e = er.element(k);
       if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
-      read_emitter(e, dim, phase_of, out.emitters.emplace_back());
+      read_emitter(e, dim, spacing, phase_of, out.emitters.emplace_back());
     }
   }
   if (r.has("sinks")) {

@@ -197,6 +197,7 @@ TEST(Inflow, BadInputNamesTheKeyAndValue) {
   expect_input_error({"/sinks/0/max=[0.5,0.2]"}, "/sinks/0/max", "[0.5,0.2]");
   expect_input_error({"/emitters/0/shape=\"cone\""}, "/emitters/0/shape", "cone");
   expect_input_error({"/emitters/0/phase=\"oil\""}, "/emitters/0/phase", "oil");
+  expect_input_error({"/emitters/0/size=1e6"}, "/emitters/0/size", "at most 10^7");
   // The device step keeps a fixed count: refused, naming the keys.
   auto scene = channel();
   auto cfg = scene.solver;
