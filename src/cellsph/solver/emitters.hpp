@@ -133,6 +133,20 @@ struct InflowHoldPass {
   }
 };
 
+// keep[i] = 0 for a fluid particle inside a sink, 1 otherwise (the end of a step).
+template <int Dim, class Real>
+struct InflowSinkPass {
+  const Vec<Dim, Real>* x;
+  std::uint8_t* keep;
+  const Sink* sinks;
+  std::size_t count;
+  CELLSPH_HD void operator()(std::size_t i) const {
+    keep[i] = 1;
+    for (std::size_t k = 0; k < count; ++k)
+      if (in_sink<Dim, Real>(sinks[k], x[i])) keep[i] = 0;
+  }
+};
+
 // Advances the emitter's `advance` by U dt and appends to `out` the positions of the layers due
 // (oldest first): each at the centre + the layer offsets + (advance - spacing / 2) n after the
 // subtraction. Returns the number of layers.

@@ -208,6 +208,15 @@ TEST(Inflow, BadInputNamesTheKeyAndValue) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("emitters"), std::string::npos) << e.what();
   }
+  // A library caller's phase without a mass: the emitter has nothing to give its particles.
+  cfg = scene.solver;
+  cfg.phases[0].mass = 0;
+  try {
+    Simulation<2, double> sim(cfg, scene.particles);
+    ADD_FAILURE() << "an emitter without a mass";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("emitters[0].phase"), std::string::npos) << e.what();
+  }
   // The config's own check (library callers): a zero normal.
   cfg = scene.solver;
   cfg.inflow.emitters[0].normal[0] = 0;

@@ -114,7 +114,13 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   // Emitters: frames from the config; the first layer is due at the start (advance = one spacing), so
   // the emitted lattice continues a fluid block that begins at the emitter plane.
   next_id_ = n;
-  for (const Emitter& e : cfg_.inflow.emitters) {
+  for (std::size_t k = 0; k < cfg_.inflow.emitters.size(); ++k) {
+    const Emitter& e = cfg_.inflow.emitters[k];
+    const auto& phase = cfg_.phases[static_cast<std::size_t>(e.phase)];
+    if (!(phase.mass > 0 && std::isfinite(phase.mass)))
+      throw InputError("emitters[" + std::to_string(k) + "].phase: phase '" + phase.name + "' has mass " +
+                       std::to_string(phase.mass) + " (phases[" + std::to_string(e.phase) +
+                       "].mass): emitted particles need one > 0");
     frames_.push_back(emitter_frame<Dim, Real>(e, cfg_.inflow.spacing, double(cfg_.support)));
     advance_.push_back(cfg_.inflow.spacing);
   }
@@ -681,15 +687,9 @@ void Simulation<Dim, Real>::inflow_end_step(Real dt) {
   std::vector<std::uint8_t> keep;
   if (!cfg_.inflow.sinks.empty()) {
     keep.assign(n, 1);
-    bool removed = false;
-    for (const std::uint32_t i : fluid_)
-      for (const Sink& s : cfg_.inflow.sinks)
-        if (in_sink<Dim, Real>(s, p_.x[i])) {
-          keep[i] = 0;
-          removed = true;
-          break;
-        }
-    if (!removed) keep.clear();
+    run_pass(fluid_, InflowSinkPass<Dim, Real>{p_.x.data(), keep.data(), cfg_.inflow.sinks.data(),
+                                               cfg_.inflow.sinks.size()});
+    if (std::find(keep.begin(), keep.end(), std::uint8_t{0}) == keep.end()) keep.clear();
   }
   std::vector<V> xs;
   std::vector<std::int32_t> emitter_of;
