@@ -228,6 +228,19 @@ TEST(Inflow, BadInputNamesTheKeyAndValue) {
   }
 }
 
+// A fixed step far too long for the inflow (U dt of 5 spacings) stops the run naming the emitter, rather
+// than emitting layers without bound.
+TEST(Inflow, StepTooLongForTheEmitterStops) {
+  auto scene = channel({"/time/stepping=\"fixed\"", "/time/dt=0.025"});
+  Simulation<2, double> sim(scene.solver, scene.particles);
+  try {
+    sim.step();
+    ADD_FAILURE() << "a step of 5 spacings went on";
+  } catch (const SimulationError& e) {
+    EXPECT_NE(std::string(e.what()).find("emitters[0]: velocity * dt = 0.05"), std::string::npos) << e.what();
+  }
+}
+
 // The layer lattice: floor(size / spacing) particles across, centred, one spacing apart; a 3D disc keeps
 // its square lattice's points within the radius (independently counted here).
 TEST(Inflow, LayerLattice) {

@@ -695,6 +695,13 @@ void Simulation<Dim, Real>::inflow_end_step(Real dt) {
   std::vector<std::int32_t> emitter_of;
   for (std::size_t e = 0; e < frames_.size(); ++e) {
     if (!active_[e]) continue;  // active at the step's start (inflow_mark)
+    // The buffer moves U dt a step: more than a few spacings means a fixed step far too long for the inflow
+    // (the Courant step keeps it below one), and a runaway count; stop with the numbers.
+    const double travel = cfg_.inflow.emitters[e].velocity * double(dt);
+    if (travel > 4 * cfg_.inflow.spacing)
+      throw SimulationError("emitters[" + std::to_string(e) + "]: velocity * dt = " + std::to_string(travel) +
+                            " m in one step, more than 4 particle spacings (" +
+                            std::to_string(cfg_.inflow.spacing) + " m): shorten the time step");
     emit_layers(frames_[e], cfg_.inflow.emitters[e].velocity, double(dt), advance_[e], xs);
     emitter_of.resize(xs.size(), static_cast<std::int32_t>(e));
   }
