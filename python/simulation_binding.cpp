@@ -2,6 +2,7 @@
 // (solver/simulation.hpp), frame writers (io/frame_output.hpp) and checkpoints
 // (io/simulation_checkpoint.hpp) for Python. Scenes are templated on dimension and precision; the choice
 // is made here, once, from the scene's header (SimImpl<Dim, Real> behind the SimBase interface).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -256,11 +257,13 @@ class SimImpl final : public SimBase {
     };
   }
 
-  // from[k]: the index of the particle with id k.
+  // from[k]: the index of the particle with the k-th smallest id (the one with id k unless emitters and
+  // sinks have changed the count: then the ids have gaps).
   [[nodiscard]] std::vector<std::uint32_t> id_order() const {
     const auto& id = sim_.particles().id;
     std::vector<std::uint32_t> from(id.size());
-    for (std::size_t s = 0; s < id.size(); ++s) from[id[s]] = static_cast<std::uint32_t>(s);
+    for (std::size_t s = 0; s < id.size(); ++s) from[s] = static_cast<std::uint32_t>(s);
+    std::sort(from.begin(), from.end(), [&id](std::uint32_t a, std::uint32_t b) { return id[a] < id[b]; });
     return from;
   }
 

@@ -38,6 +38,7 @@ def python_run(scene, out, frames, threads=2, formats="csv"):
         ("dam-break-2d", ()),  # 2D double, WCSPH, Adami walls
         ("dam-break-3d", ("/spacing=0.1",)),  # 3D float
         ("two-phase", ("/spacing=0.02",)),  # the paper's model: leap-frog, interface tension
+        ("channel-inflow", ()),  # an emitter and a sink: counts change between frames
     ],
 )
 def test_same_bits_as_cellsph_run(cellsph_binary, tmp_path, scene, sets):
@@ -78,6 +79,16 @@ def test_fields_are_copies_in_id_order_and_match_the_frames(tmp_path):
     for name in ("position", "velocity", "density", "pressure", "phase", "id"):
         assert np.array_equal(frames[-1][name], all_fields[name][fluid]), name
     assert frames[-1]["phase"].dtype == np.int32
+
+
+def test_emitted_particles_take_new_ids_in_ascending_order():
+    sim = cellsph.Simulation(cellsph.Scene.load("channel-inflow"), threads=1)
+    n0 = sim.size
+    sim.run_until(0.05)  # about 10 layers emitted, as many removed by the sink
+    ids = sim.id
+    assert np.all(np.diff(ids.astype(np.int64)) > 0)  # unique, in ascending order (the order of the fields)
+    assert ids.max() >= n0 + 50  # new ids above the initial ones
+    assert len(ids) == sim.size and int((sim.kind == 0).sum()) == sim.fluid_count
 
 
 def test_read_frames_of_a_vtu_run(cellsph_binary, tmp_path):

@@ -62,6 +62,9 @@ void write_simulation_checkpoint(const Simulation<Dim, Real>& sim, std::string_v
   put(info.user, kSimulationBlobVersion);
   put(info.user, double(st.last_dt));
   put(info.user, static_cast<std::uint8_t>(st.leapfrog_started));
+  put(info.user, st.next_id);
+  put(info.user, static_cast<std::uint32_t>(st.emitter_advance.size()));
+  for (const double a : st.emitter_advance) put(info.user, a);
   put(info.user, static_cast<std::uint64_t>(extra.size()));
   info.user.append(extra);
   // Version 2: the floating bodies' states.
@@ -83,8 +86,8 @@ std::pair<IntegratorState<Real>, std::string> parse_blob(const std::filesystem::
     r.fail("missing (the file was not written by a simulation)");
   r.bytes(sizeof kBlobMagic, "the magic");
   const auto version = r.get<std::uint32_t>("the version");
-  if (version != kSimulationBlobVersion && version != 1)
-    r.fail("version " + std::to_string(version) + " is not supported (this build reads 1 to " +
+  if (version != 1 && version != kSimulationBlobVersion)
+    r.fail("version " + std::to_string(version) + " is not supported (this build reads 1 and " +
            std::to_string(kSimulationBlobVersion) + ")");
   IntegratorState<Real> st;
   st.time = static_cast<Real>(info.time);
@@ -93,6 +96,15 @@ std::pair<IntegratorState<Real>, std::string> parse_blob(const std::filesystem::
   const auto started = r.get<std::uint8_t>("the leap-frog flag");
   if (started > 1) r.fail("leap-frog flag " + std::to_string(int(started)) + " is neither 0 nor 1");
   st.leapfrog_started = started != 0;
+  if (version >= 2) {
+    st.next_id = r.get<std::uint64_t>("the next particle id");
+    const auto emitters = r.get<std::uint32_t>("the emitter count");
+    if (emitters > r.left() / sizeof(double))
+      r.fail(std::to_string(emitters) + " emitters do not fit the " + std::to_string(r.left()) +
+             " bytes left");
+    for (std::uint32_t e = 0; e < emitters; ++e)
+      st.emitter_advance.push_back(r.get<double>("an emitter's advance"));
+  }
   const auto n = r.get<std::uint64_t>("the caller data length");
   std::string extra(r.bytes(static_cast<std::size_t>(n), "the caller data"));
   if (version >= 2) {

@@ -3,10 +3,14 @@
 // reads it for --resume): the particles and the solver state are its fields, the simulated time and step
 // count its header, and its user blob holds the rest of the integrator state and the caller's own bytes:
 //
-//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started | u64 n + n bytes caller data
-//   | (version 2:) u32 body count + per floating body its RigidBodyState (19 f64: x, q, v, w, a, alpha)
+//   char[8] "CSPHSIM1" | u32 blob version | f64 last dt | u8 leap-frog started |
+//   (version 2: u64 next particle id | u32 emitters e | e x f64 emitter advance) | u64 n + n bytes caller
+//   data | (version 2:) u32 body count + per floating body its RigidBodyState (19 f64: x, q, v, w, a,
+//   alpha)
 //
-// Version 1 (no bodies) is still read: its scenes had no floating bodies.
+// Version 2 adds the state of emitters (solver/emitters.hpp) and of floating bodies; version 1 files
+// still read (no emitters ran: the next id follows the largest id, every emitter starts as at t = 0;
+// its scenes had no floating bodies).
 // Time and last dt are stored as double: exact for float and double runs, so a resume is bit for bit.
 #include <filesystem>
 #include <string>

@@ -15,6 +15,7 @@
 #include "cellsph/geometry/shape.hpp"
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/scene/inflow_reader.hpp"
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/solver/initial.hpp"
 
@@ -1152,7 +1153,7 @@ FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const MeshFiles& fil
   if (!r.has("fluids")) r.fail("fluids", "missing (a list of fluid blocks is required)");
   auto fr = r.child("fluids");
   const std::size_t nf = fr.array_size();
-  if (nf == 0) fr.fail_here("at least one fluid block is needed");
+  if (nf == 0 && !r.has("emitters")) fr.fail_here("at least one fluid block (or an emitter) is needed");
   FluidBlocks<Dim> out;
   const double tol = 1e-9 * spacing;
   for (std::size_t k = 0; k < nf; ++k) {
@@ -1446,6 +1447,8 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   read_domain(r, cfg, regions);
   const FluidBlocks<Dim> fluids = read_fluids(r, spacing, files, phases, regions, budget, s.particles);
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
+  read_inflow(
+      r, Dim, spacing, [&phases](JsonReader& e) { return phases.read_reference(e); }, cfg.inflow);
   // Moving obstacles: every particle after the last moving one (fluid, other walls) is at rest.
   if (cfg.wall_motion.any()) cfg.wall_motion.of_particle.resize(s.particles.size(), -1);
   if (cfg.rigid_bodies.any()) cfg.rigid_bodies.of_particle.resize(s.particles.size(), -1);

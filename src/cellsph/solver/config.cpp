@@ -153,6 +153,13 @@ void SolverConfig<Dim, Real>::validate() const {
       if (b < -1 || (b >= 0 && static_cast<std::size_t>(b) >= rigid_bodies.bodies.size()))
         bad("rigid_bodies.of_particle", b, "is not -1 or a body's index");
   }
+  if (const std::string err = inflow_config_error(inflow, Dim, phases.size()); !err.empty())
+    throw InputError(err);
+  if (inflow.any() && time.mode == TimeStepping::PerParticle)
+    bad("time.mode", "per-particle", "emitters and sinks need global time steps (fixed or courant)");
+  if (inflow.any() && rigid_bodies.any())
+    bad("emitters", "set", "emitters and sinks cannot run with floating bodies yet (the bodies' tables assume "
+        "a fixed particle count)");
 }
 
 std::string_view model_name(Model m) {

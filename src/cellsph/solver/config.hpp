@@ -14,6 +14,7 @@
 #include "cellsph/solver/backend.hpp"
 #include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/boundary/wall_motion.hpp"
+#include "cellsph/solver/emitters.hpp"
 
 namespace cellsph {
 
@@ -189,6 +190,9 @@ struct SolverConfig {
   // Floating bodies (boundary/rigid_bodies.hpp; scene key bodies): their mass, inertia and initial state
   // and which boundary particle belongs to which. Empty: none. WCSPH with global steps on the CPU only.
   RigidBodies rigid_bodies{};
+  // Inflow and outflow (emitters.hpp; scene keys emitters, sinks): particle counts change during the run.
+  // CPU, global steps only.
+  Inflow inflow{};
   Real restitution = Real(0.2);
   Real friction = Real(0.1);
 

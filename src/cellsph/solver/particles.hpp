@@ -5,6 +5,7 @@
 // The storage is generic over its array type: Particles (std::vector, host memory) is what every
 // solver, reader and writer uses; DeviceParticles<Dim, Real, Space> holds the same fields in a device
 // memory space.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
@@ -120,16 +121,18 @@ struct SolverState {
   }
 };
 
-// True when particle k has id k for every k (the order the outputs are written in).
+// True when the ids ascend strictly with the index (ids 0..n-1 in order, or with the gaps that removed
+// particles leave when emitters and sinks run): the order the outputs are written in.
 template <int Dim, class Real>
 bool in_id_order(const Particles<Dim, Real>& p) {
-  for (std::size_t k = 0; k < p.id.size(); ++k)
-    if (p.id[k] != k) return false;
+  for (std::size_t k = 1; k < p.id.size(); ++k)
+    if (!(p.id[k - 1] < p.id[k])) return false;
   return p.id.size() == p.size();
 }
 
-// dst = src with every field gathered into id order (dst particle k is the src particle with id k);
-// `from` receives the src index of each dst particle. The ids must be a permutation of 0..n-1.
+// dst = src with every field gathered into ascending id order (dst particle k is the src particle with
+// the k-th smallest id: the one with id k when the ids are a permutation of 0..n-1); `from` receives the
+// src index of each dst particle. The ids must be unique.
 template <int Dim, class Real>
 void copy_in_id_order(const Particles<Dim, Real>& src, Particles<Dim, Real>& dst,
                       std::vector<std::uint32_t>& from) {
@@ -137,11 +140,23 @@ void copy_in_id_order(const Particles<Dim, Real>& src, Particles<Dim, Real>& dst
   CELLSPH_CHECK(src.id.size() == n, "particle ids: " << src.id.size() << " for " << n << " particles");
   constexpr std::uint32_t kNone = ~std::uint32_t{0};
   from.assign(n, kNone);
-  for (std::size_t s = 0; s < n; ++s) {
+  bool permutation = true;
+  for (std::size_t s = 0; s < n && permutation; ++s) {
     const std::uint32_t k = src.id[s];
-    CELLSPH_CHECK(k < n && from[k] == kNone,
-                  "particle ids are not a permutation: particle " << s << " has id " << k);
+    if (k >= n || from[k] != kNone) {
+      permutation = false;
+      break;
+    }
     from[k] = static_cast<std::uint32_t>(s);
+  }
+  if (!permutation) {  // emitted and removed particles: sort by id
+    for (std::size_t s = 0; s < n; ++s) from[s] = static_cast<std::uint32_t>(s);
+    std::sort(from.begin(), from.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return src.id[a] < src.id[b]; });
+    for (std::size_t k = 1; k < n; ++k)
+      CELLSPH_CHECK(src.id[from[k - 1]] != src.id[from[k]], "particle ids are not unique: particles "
+                                                                << from[k - 1] << " and " << from[k]
+                                                                << " have id " << src.id[from[k]]);
   }
   dst.resize(n);
   Particles<Dim, Real>::for_each_field(src, [&](std::string_view name, const auto& field) {

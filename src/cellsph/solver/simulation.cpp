@@ -111,6 +111,19 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   if (const auto err = id_permutation_error(p_.id); !err.empty()) throw InputError("particles: " + err);
   rho0_.assign(n, Real(0));
   state_.assign_zero(n);
+  // Emitters: frames from the config; the first layer is due at the start (advance = one spacing), so
+  // the emitted lattice continues a fluid block that begins at the emitter plane.
+  next_id_ = n;
+  for (std::size_t k = 0; k < cfg_.inflow.emitters.size(); ++k) {
+    const Emitter& e = cfg_.inflow.emitters[k];
+    const auto& phase = cfg_.phases[static_cast<std::size_t>(e.phase)];
+    if (!(phase.mass > 0 && std::isfinite(phase.mass)))
+      throw InputError("emitters[" + std::to_string(k) + "].phase: phase '" + phase.name + "' has mass " +
+                       std::to_string(phase.mass) + " (phases[" + std::to_string(e.phase) +
+                       "].mass): emitted particles need one > 0");
+    frames_.push_back(emitter_frame<Dim, Real>(e, cfg_.inflow.spacing, double(cfg_.support)));
+    advance_.push_back(cfg_.inflow.spacing);
+  }
   // Moving walls: each particle's motion and initial position, kept by id (the input order's index is
   // lost when the boundary is reordered below).
   if (cfg_.wall_motion.any()) {
@@ -604,6 +617,7 @@ void Simulation<Dim, Real>::step() {
     timings_.reorder += sw.ms();
     sw.reset();
   }
+  inflow_mark();
   compute_neighbors();
   timings_.neighbors += sw.ms();
 
@@ -628,6 +642,7 @@ void Simulation<Dim, Real>::step() {
     integrate_paper(dt);
   else
     integrate_wcsph(dt);
+  inflow_hold(dt);
   apply_walls();
   check_state();
   time_ += dt;
@@ -635,6 +650,7 @@ void Simulation<Dim, Real>::step() {
   ++steps_;
   move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
   if (bodies_.any()) advance_bodies(dt);
+  inflow_end_step(dt);
   timings_.integration += sw.ms();
 }
 
@@ -653,13 +669,154 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   const Real dt = dfsph_step(cfg_, view(), fluid_, df_diameter_, dfsph_stats_, steps_ + 1);
   timings_.forces += sw.ms();
   sw.reset();
+  inflow_hold(dt);
   apply_walls();
   check_state();
   time_ += dt;
   last_dt_ = dt;
   ++steps_;
   move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
+  inflow_end_step(dt);
   timings_.integration += sw.ms();
+}
+
+// The kind lists, rest densities and search radii from the particles (after a restore or a count change).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::rebuild_kind_lists() {
+  fluid_.clear();
+  boundary_.clear();
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
+    const bool fluid = p_.kind[i] == kFluid;
+    (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
+    search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
+  }
+  fluid_count_ = fluid_.size();
+  lists_valid_ = false;
+}
+
+// The fluid particles in the buffer of an emitter active at the step's start (emitters.hpp), with their
+// positions at that time.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::inflow_mark() {
+  held_.clear();
+  held_x_.clear();
+  held_emitter_.clear();
+  if (frames_.empty()) return;
+  active_.assign(frames_.size(), 0);
+  bool any = false;
+  for (std::size_t e = 0; e < frames_.size(); ++e) {
+    const Emitter& em = cfg_.inflow.emitters[e];
+    active_[e] = double(time_) >= em.start && double(time_) < em.end ? 1 : 0;
+    any = any || active_[e];
+  }
+  if (!any) return;
+  held_of_.resize(p_.size());
+  run_pass(fluid_, InflowMarkPass<Dim, Real>{p_.x.data(), held_of_.data(), frames_.data(), active_.data(),
+                                             frames_.size()});
+  for (const std::uint32_t i : fluid_)
+    if (held_of_[i] >= 0) {
+      held_.push_back(i);
+      held_x_.push_back(p_.x[i]);
+      held_emitter_.push_back(held_of_[i]);
+    }
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::inflow_hold(Real dt) {
+  if (held_.empty()) return;
+  run_pass(held_.size(), InflowHoldPass<Dim, Real>{p_.x.data(), p_.v.data(), held_.data(), held_x_.data(),
+                                                   held_emitter_.data(), frames_.data(), dt});
+}
+
+// After the step: the sinks' particles are removed, then the layers due are appended (oldest first, emitter
+// by emitter), with new ids. An emitted particle is fluid of the emitter's phase at rest density and zero
+// pressure, moving at U along the normal (the paper model's half-step velocity too), with zero solver state.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::inflow_end_step(Real dt) {
+  if (!cfg_.inflow.any()) return;
+  const std::size_t n = p_.size();
+  std::vector<std::uint8_t> keep;
+  if (!cfg_.inflow.sinks.empty()) {
+    keep.assign(n, 1);
+    run_pass(fluid_, InflowSinkPass<Dim, Real>{p_.x.data(), keep.data(), cfg_.inflow.sinks.data(),
+                                               cfg_.inflow.sinks.size()});
+    if (std::find(keep.begin(), keep.end(), std::uint8_t{0}) == keep.end()) keep.clear();
+  }
+  std::vector<V> xs;
+  std::vector<std::int32_t> emitter_of;
+  for (std::size_t e = 0; e < frames_.size(); ++e) {
+    if (!active_[e]) continue;  // active at the step's start (inflow_mark)
+    // The buffer moves U dt a step: more than a few spacings means a fixed step far too long for the inflow
+    // (the Courant step keeps it below one), and a runaway count; stop with the numbers.
+    const double travel = cfg_.inflow.emitters[e].velocity * double(dt);
+    if (travel > 4 * cfg_.inflow.spacing)
+      throw SimulationError("emitters[" + std::to_string(e) + "]: velocity * dt = " + std::to_string(travel) +
+                            " m in one step, more than 4 particle spacings (" +
+                            std::to_string(cfg_.inflow.spacing) + " m): shorten the time step");
+    emit_layers(frames_[e], cfg_.inflow.emitters[e].velocity, double(dt), advance_[e], xs);
+    emitter_of.resize(xs.size(), static_cast<std::int32_t>(e));
+  }
+  if (keep.empty() && xs.empty()) return;
+  if (next_id_ + xs.size() > std::uint64_t{std::numeric_limits<std::uint32_t>::max()} + 1)
+    throw SimulationError("emitters: the 2^32 particle ids are used up at t = " + std::to_string(time_) +
+                          " s");
+  change_count(keep, xs.size());
+  const std::size_t first = p_.size() - xs.size();
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    const std::size_t i = first + k;
+    const auto& frame = frames_[static_cast<std::size_t>(emitter_of[k])];
+    const std::int32_t ph = cfg_.inflow.emitters[static_cast<std::size_t>(emitter_of[k])].phase;
+    const auto& phase = cfg_.phases[static_cast<std::size_t>(ph)];
+    p_.x[i] = xs[k];
+    p_.v[i] = frame.velocity;
+    p_.m[i] = phase.mass;
+    p_.rho[i] = phase.rest_density;
+    p_.h[i] = cfg_.support;
+    p_.color[i] = phase.color;
+    p_.mu[i] = phase.viscosity;
+    p_.phase[i] = ph;
+    p_.kind[i] = kFluid;
+    p_.id[i] = static_cast<std::uint32_t>(next_id_++);
+  }
+  rebuild_kind_lists();
+  set_moving_slots();
+  move_walls(time_);
+}
+
+// Stable compaction by `keep`, then `added` zero entries, in every array of one entry per particle (those
+// of another size are scratch not in use, as in reorder_slots).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::change_count(const std::vector<std::uint8_t>& keep, std::size_t added) {
+  const std::size_t n = p_.size();
+  auto edit = [&](auto& field) {
+    if (field.size() != n) return;
+    std::size_t w = n;
+    if (!keep.empty()) {
+      w = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        if (keep[i]) field[w++] = field[i];
+    }
+    field.resize(w);
+    field.resize(w + added);
+  };
+  p_.for_each_field([&](std::string_view, auto& field) { edit(field); });
+  state_.for_each_field([&](std::string_view, auto& field) { edit(field); });
+  edit(rho0_);
+  edit(search_h_);
+  edit(vol_);
+  edit(prho2_);
+  edit(f_pressure_);
+  edit(normal_);
+  edit(wall_v_);
+  edit(wall_self_rho_);
+  edit(wall_a_);
+  edit(drho_);
+  edit(df_alpha_);
+  edit(df_kappa_);
+  edit(within_count_);
+  edit(held_of_);
+  lists_valid_ = false;
 }
 
 template <int Dim, class Real>
@@ -698,7 +855,8 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state,
                                     const std::string& source, SolverState<Dim, Real> solver) {
   const std::size_t n = particles.size();
-  if (n != p_.size()) {
+  const bool inflow = cfg_.inflow.any();
+  if (n != p_.size() && !inflow) {
     throw InputError(source + ": holds " + std::to_string(n) + " particles, the scene has " +
                      std::to_string(p_.size()));
   }
@@ -706,8 +864,29 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
     throw InputError(source + ": holds " + std::to_string(particles.id.size()) + " particle ids for " +
                      std::to_string(n) + " particles");
   }
-  if (const auto err = id_permutation_error(particles.id); !err.empty())
+  // With emitters and sinks the ids are unique and below the next id (emitted particles take new ids,
+  // removed ones leave gaps); otherwise a permutation of 0..n-1.
+  std::uint64_t next_id = state.next_id;
+  if (inflow) {
+    std::vector<std::uint32_t> ids = particles.id;
+    std::sort(ids.begin(), ids.end());
+    for (std::size_t i = 1; i < ids.size(); ++i)
+      if (ids[i] == ids[i - 1])
+        throw InputError(source + ": two particles have id " + std::to_string(ids[i]));
+    const std::uint64_t above = ids.empty() ? 0 : std::uint64_t{ids.back()} + 1;
+    if (next_id == 0) next_id = above;
+    if (next_id < above)
+      throw InputError(source + ": particle id " + std::to_string(ids.back()) + " is not below the next id " +
+                       std::to_string(next_id));
+    if (!state.emitter_advance.empty() && state.emitter_advance.size() != frames_.size())
+      throw InputError(source + ": holds the state of " + std::to_string(state.emitter_advance.size()) +
+                       " emitters, the scene has " + std::to_string(frames_.size()));
+    for (const double a : state.emitter_advance)
+      if (!(a >= 0 && a < 2 * cfg_.inflow.spacing))
+        throw InputError(source + ": emitter advance " + std::to_string(a) + " is outside [0, 2 spacings)");
+  } else if (const auto err = id_permutation_error(particles.id); !err.empty()) {
     throw InputError(source + ": " + err);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     if (particles.phase[i] < 0 || static_cast<std::size_t>(particles.phase[i]) >= cfg_.phases.size() ||
         particles.kind[i] > kBoundary) {
@@ -777,17 +956,19 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
                      std::to_string(hi_tick) + ", more than 2^" + std::to_string(cfg_.time.max_level) +
                      " (one largest step)");
   p_ = std::move(particles);
-  fluid_.clear();
-  boundary_.clear();
-  for (std::size_t i = 0; i < p_.size(); ++i) {
-    rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
-    const bool fluid = p_.kind[i] == kFluid;
-    (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
-    search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
-  }
-  fluid_count_ = fluid_.size();
-  lists_valid_ = false;
+  // Scratch arrays hold nothing across steps: with another count they start afresh at the new size.
+  if (f_pressure_.size() != n) f_pressure_.assign(n, V{});
+  rho0_.resize(n);
+  search_h_.resize(n);
+  rebuild_kind_lists();
   state_ = std::move(solver);
+  if (inflow) {
+    next_id_ = next_id;
+    if (!state.emitter_advance.empty())
+      advance_ = state.emitter_advance;
+    else
+      advance_.assign(frames_.size(), cfg_.inflow.spacing);
+  }
   // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
   // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
   // the file's fault, named as such (the Simulation is then not usable; the caller stops).

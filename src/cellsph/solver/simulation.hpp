@@ -35,6 +35,7 @@
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_stepper_base.hpp"
+#include "cellsph/solver/emitters.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
 #include "cellsph/solver/particle_view.hpp"
 #include "cellsph/solver/particles.hpp"
@@ -64,6 +65,10 @@ struct IntegratorState {
   Real last_dt = 0;               // the last step's dt (the paper model's leap-frog needs it)
   std::uint64_t steps = 0;        // steps taken
   bool leapfrog_started = false;  // paper model: particles().v holds v(t - dt/2)
+  // Emitters and sinks (emitters.hpp): the id the next emitted particle gets (0 on restore: the largest
+  // id + 1) and, per emitter, the distance its newest layer has travelled (empty on restore: as at t = 0).
+  std::uint64_t next_id = 0;
+  std::vector<double> emitter_advance{};
 };
 
 template <int Dim, class Real>
@@ -119,10 +124,11 @@ class Simulation {
     return state_;
   }
   [[nodiscard]] IntegratorState<Real> integrator_state() const {
-    return {time_, last_dt_, steps_, leapfrog_started_};
+    return {time_, last_dt_, steps_, leapfrog_started_, next_id_, advance_};
   }
   // Replaces the particles and the integrator state. Throws InputError, prefixed with `source` (the
-  // checkpoint file), when the particles do not fit this simulation: count, phase or kind not in its
+  // checkpoint file), when the particles do not fit this simulation: count (any count with emitters or
+  // sinks; ids then unique and below the state's next id rather than a permutation), phase or kind not in its
   // tables, ids not a permutation, values no run holds (non-finite, support <= 0, time-step level or tick
   // out of range, non-finite or negative time). The simulation is untouched on those errors; with dynamic
   // walls, positions beyond what the neighbour search indexes are found after the particles were
@@ -205,6 +211,15 @@ class Simulation {
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
   // ties by id; every per-particle array is permuted and the Verlet lists invalidated.
   void reorder_slots(const IndexList& slots);
+  // Emitters and sinks (emitters.hpp): mark the buffer's particles at the start of a step, hold them after
+  // the integration, then emit layers and remove the sinks' particles at the end of the step.
+  void inflow_mark();
+  void inflow_hold(Real dt);
+  void inflow_end_step(Real dt);
+  // Removes the particles with keep[i] == 0 (stable; keep empty: none) and appends `added` particles
+  // (zero-filled, for the caller to set), in every per-particle array; rebuilds the kind lists.
+  void change_count(const std::vector<std::uint8_t>& keep, std::size_t added);
+  void rebuild_kind_lists();
 
   Config cfg_;
   // Mutable: with a device backend, particles() (const) copies the device's newer state back here.
@@ -293,6 +308,18 @@ class Simulation {
   std::vector<Real> df_grad_;
   Real df_diameter_ = 0;
   DfsphStats dfsph_stats_;
+
+  // Emitters and sinks (config inflow, emitters.hpp): each emitter's frame and layer lattice (from the
+  // config), its `advance` and the next free id (integrator state, checkpointed); the step's held
+  // buffer particles (slot, start position, emitter), rebuilt every step.
+  std::vector<EmitterFrame<Dim, Real>> frames_;
+  std::vector<double> advance_;
+  std::uint64_t next_id_ = 0;
+  std::vector<std::int32_t> held_of_;
+  IndexList held_;
+  std::vector<V> held_x_;
+  std::vector<std::int32_t> held_emitter_;
+  std::vector<std::uint8_t> active_;
 };
 
 extern template class Simulation<2, float>;

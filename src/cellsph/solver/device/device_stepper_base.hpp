@@ -86,6 +86,9 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
+  if (cfg.inflow.any())
+    return "emitters and sinks (scene keys emitters, sinks) change the particle count, which the device "
+           "step does not (run them with --backend cpu)";
   return {};
 }
 
