@@ -11,6 +11,7 @@
 
 namespace {
 
+using cellsph::test::csv_rows;
 using cellsph::test::q;
 using cellsph::test::read_file;
 using cellsph::test::run_cli;
@@ -19,22 +20,6 @@ namespace fs = std::filesystem;
 
 // The scene at twice its spacing (about 1,000 fluid particles), to keep the runs short.
 const std::string kCoarse = " --set /spacing=0.02 --set /solver/support=0.04";
-
-std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
-  std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> row(1);
-  for (char c : text) {
-    if (c == ',') {
-      row.emplace_back();
-    } else if (c == '\n') {
-      rows.push_back(row);
-      row.assign(1, "");
-    } else {
-      row.back() += c;
-    }
-  }
-  return rows;
-}
 
 TEST(CliRunBodies, BodiesCsvHasOneRowPerBodyAndFrame) {
   TempDir dir;

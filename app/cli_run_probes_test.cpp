@@ -10,6 +10,7 @@
 
 namespace {
 
+using cellsph::test::csv_rows;
 using cellsph::test::q;
 using cellsph::test::read_file;
 using cellsph::test::run_cli;
@@ -23,22 +24,6 @@ const std::string kProbes =
     " --set '/probes=[{\"name\":\"p_0.1\",\"kind\":\"pressure\",\"at\":[0.5,0.1]},"
     "{\"name\":\"gauge\",\"kind\":\"level\",\"at\":[0.5,0]},"
     "{\"name\":\"u\",\"kind\":\"velocity\",\"at\":[0.3,0.25]}]'";
-
-std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
-  std::vector<std::vector<std::string>> rows;
-  std::vector<std::string> row(1);
-  for (char c : text) {
-    if (c == ',') {
-      row.emplace_back();
-    } else if (c == '\n') {
-      rows.push_back(row);
-      row.assign(1, "");
-    } else {
-      row.back() += c;
-    }
-  }
-  return rows;
-}
 
 TEST(CliRunProbes, ARestingTankReadsItsDepthAndHydrostaticPressure) {
   TempDir dir;

@@ -58,6 +58,23 @@ inline std::string read_file(const fs::path& p) {
   return s.str();
 }
 
+// The cells of a CSV text, row by row (no quoting: the files our runs write).
+inline std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> row(1);
+  for (char c : text) {
+    if (c == ',') {
+      row.emplace_back();
+    } else if (c == '\n') {
+      rows.push_back(row);
+      row.assign(1, "");
+    } else {
+      row.back() += c;
+    }
+  }
+  return rows;
+}
+
 struct RunResult {
   int code = -1;
   std::string out;
