@@ -309,7 +309,8 @@ class CellIndex {
       } else if (sort) {
         rank_sort(buf, static_cast<std::uint32_t>(len), row);
       } else {
-        std::memcpy(row, buf, len * sizeof(std::uint32_t));
+        if (len > 0)
+          std::memcpy(row, buf, len * sizeof(std::uint32_t));  // row is null when no list has pairs
       }
     };
     if (sorted_rows_)
