@@ -158,7 +158,8 @@ void SolverConfig<Dim, Real>::validate() const {
   if (inflow.any() && time.mode == TimeStepping::PerParticle)
     bad("time.mode", "per-particle", "emitters and sinks need global time steps (fixed or courant)");
   if (inflow.any() && rigid_bodies.any())
-    bad("emitters", "set", "emitters and sinks cannot run with floating bodies yet (the bodies' tables assume "
+    bad("emitters", "set",
+        "emitters and sinks cannot run with floating bodies yet (the bodies' tables assume "
         "a fixed particle count)");
 }
 
