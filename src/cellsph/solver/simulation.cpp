@@ -396,13 +396,32 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     if (!moving_.empty()) d2 = std::max(d2, reduce_max(moving_, MaxValue<Real>{}, disp).value);
     if (bodies_.any()) d2 = std::max(d2, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
-    if (d2 <= limit * limit) return;
+    if (d2 <= limit * limit) {
+      ++lists_kept_;
+      return;
+    }
+    // Lists that did not last a single step: the skin only made the search and the filter longer (DFSPH's
+    // CFL steps move the fastest particle 0.4 d, three times 0.45 of the default skin). Search at the
+    // bare supports for a while, then try the skin again.
+    if (lists_kept_ == 0) bare_searches_ = kBareSearches;
+  }
+  ++timings_.list_builds;
+  if (skin_ > 0 && bare_searches_ > 0) {
+    --bare_searches_;
+    ++timings_.bare_builds;
+    bare_h_.resize(search_h_.size());
+    for (std::size_t i = 0; i < search_h_.size(); ++i)
+      bare_h_[i] = search_h_[i] > 0 ? search_h_[i] - skin_ : Real(0);
+    search_.build(std::span<const V>(p_.x), std::span<const Real>(bare_h_));
+    search_.find_all(nl_);
+    lists_valid_ = false;  // rows within h only: the next step searches again
+    return;
   }
   search_.build(std::span<const V>(p_.x), std::span<const Real>(search_h_));
   search_.find_all(nl_);
   if (skin_ > 0) x_built_ = p_.x;
   lists_valid_ = true;
-  ++timings_.list_builds;
+  lists_kept_ = 0;
 }
 
 // The rows of `set` cut down to the pairs within h_i (verlet_rows.hpp).

@@ -49,6 +49,7 @@ struct StepTimings {
   double forces = 0;              // density, pressure, forces
   double integration = 0;         // time step choice, integration, walls, stability check
   std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
+  std::uint64_t bare_builds = 0;  // of which at the bare supports (skinned lists did not last a step)
   double reorder = 0;             // permuting the particles into cell order (config reorder_every)
   std::uint64_t reorders = 0;     // reorders run
   // Work done, in particles (summed over steps): a global step evaluates every fluid particle once; a
@@ -270,6 +271,13 @@ class Simulation {
   std::vector<V> x_built_;      // positions the lists were built from
   Real skin_ = 0;
   bool lists_valid_ = false;
+  // Steps the current lists have been kept; when skinned lists do not last one step, the next
+  // kBareSearches searches run at the bare supports (bare_h_: search_h_ less the skin), whose rows hold
+  // the same pairs within h. The schedule changes the speed only, never a result.
+  std::uint32_t lists_kept_ = 0;
+  std::uint32_t bare_searches_ = 0;
+  static constexpr std::uint32_t kBareSearches = 16;
+  std::vector<Real> bare_h_;
   bool any_tension_ = false;
   // WallModel::Adami or Dynamic and there are boundary particles: walls carry their own p, rho (and
   // velocity for no slip), computed each step by compute_wall_states.
