@@ -577,7 +577,8 @@ void register_run(CLI::App& app, int& result) {
   sub->add_flag("--quiet", opt->quiet, "No progress line and no summary");
   sub->add_option("--resume", opt->resume, "Continue the run in this output folder from its last checkpoint");
   sub->add_option("--set", opt->sets,
-                  "Edit the scene before the run: /json/pointer=value (a JSON value, else a string), e.g. "
+                  "Edit the scene before the run: /json/pointer=value (a JSON value, else a string; null "
+                  "removes the key), e.g. "
                   "--set /spacing=0.01 --set /boundary/model=akinci; repeatable; saved in run.json");
   sub->callback([opt, &result] { result = run_command(*opt); });
 

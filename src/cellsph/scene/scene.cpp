@@ -128,8 +128,19 @@ void apply_scene_edits(nlohmann::json& j, const std::vector<std::string>& edits,
     nlohmann::json value = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (value.is_discarded()) value = text;
     try {
-      check_array_indices(j, e, e.substr(0, eq));
-      j[nlohmann::json::json_pointer(e.substr(0, eq))] = std::move(value);
+      const nlohmann::json::json_pointer ptr(e.substr(0, eq));
+      if (value.is_null()) {  // null removes the key (no scene key takes null)
+        if (!j.contains(ptr))
+          throw InputError("--set '" + e + "': " + ptr.to_string() + " is not in the scene");
+        nlohmann::json& parent = j[ptr.parent_pointer()];
+        if (parent.is_array())
+          parent.erase(static_cast<std::size_t>(std::stoul(ptr.back())));
+        else
+          parent.erase(ptr.back());
+      } else {
+        check_array_indices(j, e, e.substr(0, eq));
+        j[ptr] = std::move(value);
+      }
     } catch (const nlohmann::json::exception& ex) {
       throw InputError("--set '" + e + "': " + ex.what());
     }

@@ -224,6 +224,23 @@ TEST(Scene, EditsSetValuesAtTheirPointers) {
   EXPECT_EQ(fluid, 200u);
 }
 
+// null removes a key (or an array element): how a scene drops a block another model refuses.
+TEST(Scene, NullEditRemovesTheKey) {
+  auto j = nlohmann::json::parse(kMinimal);
+  std::string src = "scene.json";
+  j["solver"]["note"] = 1;
+  j["list"] = nlohmann::json::parse("[1, 2, 3]");
+  apply_scene_edits(j, {"/solver/note=null", "/list/1=null"}, src);
+  EXPECT_FALSE(j["solver"].contains("note"));
+  EXPECT_EQ(j["list"], nlohmann::json::parse("[1, 3]"));
+  try {
+    apply_scene_edits(j, {"/solver/nothing=null"}, src);
+    FAIL() << "removed a key that is not there";
+  } catch (const InputError& ex) {
+    EXPECT_EQ(std::string(ex.what()), "--set '/solver/nothing=null': /solver/nothing is not in the scene");
+  }
+}
+
 TEST(Scene, BadEditsNameTheEdit) {
   for (const std::string e : {"spacing=0.1", "/spacing", "/=1", "/spacing=", "/fluids/x/min=1"}) {
     auto j = nlohmann::json::parse(kMinimal);
