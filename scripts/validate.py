@@ -3,8 +3,11 @@
 
 Usage: scripts/validate.py CASE [--spacing S] [--until T] [--build DIR] [--out RUN_DIR] [--no-run]
                            [--threads N] [--figure FILE.png] [--walls MODEL] [--set /POINTER=VALUE ...]
+                           [--compare RUN_DIR [--compare-label TEXT]]
 
-CASE is `lobovsky` (built-in scene lobovsky-2014: Lobovsky et al. 2014, H = 0.3 m, 2D), `spheric`
+CASE is `lobovsky` (built-in scene lobovsky-2014: Lobovsky et al. 2014, H = 0.3 m, 2D), `lobovsky-gate`
+(built-in scene lobovsky-2014-gate: the same column released by the experiment's gate, lifted at 4.5 m/s
+from t = 0; --compare RUN_DIR draws another run, e.g. the instant release's, dashed), `spheric`
 (built-in scene spheric-test2: SPHERIC Test 2, Kleefsman et al. 2005, 3D) or `martin-moyce-a` /
 `martin-moyce-b` (dam-break-2d's set-up against Martin & Moyce 1952's residual column height at the back
 wall, tables [A] and [B] of data/validation/martin_moyce_1952.txt: [A] the scene's 1 m x 2 m column in its
@@ -306,7 +309,7 @@ def compare_martin_moyce(run_dir, table):
     return sim, pts
 
 
-def figure(path, case, sim, ref, window, title):
+def figure(path, case, sim, ref, window, title, other=None):
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -330,7 +333,9 @@ def figure(path, case, sim, ref, window, title):
             for m, s, style in zip(meas, series, ("k.", "kx")):
                 ax.plot([t for t in dt if t <= window * 1.3], m[:sum(t <= window * 1.3 for t in dt)], style, ms=2.5,
                         label=f"experiment {s}")
-            ax.plot(sim["time"], sim[g], "C0-", lw=1.4, label="cellsph")
+            ax.plot(sim["time"], sim[g], "C0-", lw=1.4, label=f"cellsph ({case['scene']})")
+            if other:
+                ax.plot(other[1]["time"], other[1][g], "C1--", lw=1.0, label=other[0])
             ax.set_title(f"level at x = {case['gauges'][g]} m", fontsize=9)
             ax.set_ylabel("level [m]")
             ax.grid(alpha=0.3)
@@ -368,8 +373,11 @@ def main():
     ap.add_argument("--no-run", action="store_true")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--figure")
+    ap.add_argument("--compare", metavar="RUN_DIR", help="Lobovsky: also draw this run's levels (dashed)")
+    ap.add_argument("--compare-label", default="other run", help="the legend of --compare's run")
     a = ap.parse_args()
-    case = {"lobovsky": LOBOVSKY, "lobovsky-gate": LOBOVSKY_GATE, "spheric": SPHERIC, "martin-moyce-a": "A", "martin-moyce-b": "B"}[a.case]
+    case = {"lobovsky": LOBOVSKY, "lobovsky-gate": LOBOVSKY_GATE, "spheric": SPHERIC, "martin-moyce-a": "A",
+            "martin-moyce-b": "B"}[a.case]
     if a.spacing is None:
         a.spacing = {"lobovsky": 0.005, "lobovsky-gate": 0.005, "spheric": 0.02}.get(a.case, 0.05)
     if not a.spacing > 0:
@@ -379,6 +387,10 @@ def main():
                    "spheric": 2.0,
                    "martin-moyce-a": 2.5 / math.sqrt(G), "martin-moyce-b": 6.35 / math.sqrt(G)}[a.case]
     a.out = a.out or f"validate-{a.case}-{a.spacing:g}"
+    if a.compare and case not in (LOBOVSKY, LOBOVSKY_GATE):
+        sys.exit("--compare: only for the lobovsky cases")
+    if a.compare and not os.path.exists(os.path.join(a.compare, "probes.csv")):
+        sys.exit(f"--compare: {os.path.join(a.compare, 'probes.csv')}: not found")
     if not a.no_run:
         run_scene(a, case)
     if not os.path.exists(os.path.join(a.out, "probes.csv")):
@@ -395,7 +407,10 @@ def main():
     else:
         sim, ref, _, window = compare_spheric(a.out, a.until)
         title = f"spheric-test2, 3D WCSPH, spacing {a.spacing:g} m, against Kleefsman et al. 2005"
-    figure(a.figure or os.path.join(a.out, "validation.png"), case, sim, ref, window, title)
+    other = None
+    if a.compare:
+        other = (a.compare_label, read_table(os.path.join(a.compare, "probes.csv"))[1])
+    figure(a.figure or os.path.join(a.out, "validation.png"), case, sim, ref, window, title, other)
     return 0
 
 
