@@ -3,8 +3,11 @@
 
 Usage: scripts/validate.py CASE [--spacing S] [--until T] [--build DIR] [--out RUN_DIR] [--no-run]
                            [--threads N] [--figure FILE.png] [--walls MODEL] [--set /POINTER=VALUE ...]
+                           [--compare RUN_DIR [--compare-label TEXT]]
 
-CASE is `lobovsky` (built-in scene lobovsky-2014: Lobovsky et al. 2014, H = 0.3 m, 2D), `spheric`
+CASE is `lobovsky` (built-in scene lobovsky-2014: Lobovsky et al. 2014, H = 0.3 m, 2D), `lobovsky-gate`
+(built-in scene lobovsky-2014-gate: the same column released by the experiment's gate, lifted at 4.5 m/s
+from t = 0; --compare RUN_DIR draws another run, e.g. the instant release's, dashed), `spheric`
 (built-in scene spheric-test2: SPHERIC Test 2, Kleefsman et al. 2005, 3D) or `martin-moyce-a` /
 `martin-moyce-b` (dam-break-2d's set-up against Martin & Moyce 1952's residual column height at the back
 wall, tables [A] and [B] of data/validation/martin_moyce_1952.txt: [A] the scene's 1 m x 2 m column in its
@@ -51,6 +54,9 @@ LOBOVSKY = {
     "in_column": {"h_x0300"},
     "threshold": 0.03,  # [m], 0.1 H
 }
+# The same comparison for lobovsky-2014-gate: the column released by the experiment's gate (lifted at
+# 4.5 m/s from t = 0, the experiment's time origin) instead of instantly.
+LOBOVSKY_GATE = dict(LOBOVSKY, scene="lobovsky-2014-gate")
 SPHERIC = {
     "scene": "spheric-test2",
     "data": "spheric_test2_kleefsman2005.tsv",
@@ -303,7 +309,7 @@ def compare_martin_moyce(run_dir, table):
     return sim, pts
 
 
-def figure(path, case, sim, ref, window, title):
+def figure(path, case, sim, ref, window, title, other=None):
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -320,14 +326,16 @@ def figure(path, case, sim, ref, window, title):
         ax.set_ylabel("residual height / column height")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    elif case is LOBOVSKY:
+    elif case in (LOBOVSKY, LOBOVSKY_GATE):
         fig, axes = plt.subplots(2, 2, figsize=(9, 5.5), sharex=True)
         for ax, g in zip(axes.flat, case["gauges"]):
             dt, meas, series = ref[g]
             for m, s, style in zip(meas, series, ("k.", "kx")):
                 ax.plot([t for t in dt if t <= window * 1.3], m[:sum(t <= window * 1.3 for t in dt)], style, ms=2.5,
                         label=f"experiment {s}")
-            ax.plot(sim["time"], sim[g], "C0-", lw=1.4, label="cellsph")
+            ax.plot(sim["time"], sim[g], "C0-", lw=1.4, label=f"cellsph ({case['scene']})")
+            if other:
+                ax.plot(other[1]["time"], other[1][g], "C1--", lw=1.0, label=other[0])
             ax.set_title(f"level at x = {case['gauges'][g]} m", fontsize=9)
             ax.set_ylabel("level [m]")
             ax.grid(alpha=0.3)
@@ -355,7 +363,7 @@ def figure(path, case, sim, ref, window, title):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=["lobovsky", "spheric", "martin-moyce-a", "martin-moyce-b"])
+    ap.add_argument("case", choices=["lobovsky", "lobovsky-gate", "spheric", "martin-moyce-a", "martin-moyce-b"])
     ap.add_argument("--walls", default="adami", choices=["adami", "akinci", "dynamic"])
     ap.add_argument("--set", action="append", default=[], help="a further scene edit, as cellsph run's --set")
     ap.add_argument("--spacing", type=float)
@@ -365,16 +373,24 @@ def main():
     ap.add_argument("--no-run", action="store_true")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--figure")
+    ap.add_argument("--compare", metavar="RUN_DIR", help="Lobovsky: also draw this run's levels (dashed)")
+    ap.add_argument("--compare-label", default="other run", help="the legend of --compare's run")
     a = ap.parse_args()
-    case = {"lobovsky": LOBOVSKY, "spheric": SPHERIC, "martin-moyce-a": "A", "martin-moyce-b": "B"}[a.case]
+    case = {"lobovsky": LOBOVSKY, "lobovsky-gate": LOBOVSKY_GATE, "spheric": SPHERIC, "martin-moyce-a": "A",
+            "martin-moyce-b": "B"}[a.case]
     if a.spacing is None:
-        a.spacing = {"lobovsky": 0.005, "spheric": 0.02}.get(a.case, 0.05)
+        a.spacing = {"lobovsky": 0.005, "lobovsky-gate": 0.005, "spheric": 0.02}.get(a.case, 0.05)
     if not a.spacing > 0:
         sys.exit(f"--spacing: must be > 0, got {a.spacing}")
     if a.until is None:
-        a.until = {"lobovsky": 6 * math.sqrt(LOBOVSKY["H"] / G), "spheric": 2.0,
+        a.until = {"lobovsky": 6 * math.sqrt(LOBOVSKY["H"] / G), "lobovsky-gate": 6 * math.sqrt(LOBOVSKY["H"] / G),
+                   "spheric": 2.0,
                    "martin-moyce-a": 2.5 / math.sqrt(G), "martin-moyce-b": 6.35 / math.sqrt(G)}[a.case]
     a.out = a.out or f"validate-{a.case}-{a.spacing:g}"
+    if a.compare and case not in (LOBOVSKY, LOBOVSKY_GATE):
+        sys.exit("--compare: only for the lobovsky cases")
+    if a.compare and not os.path.exists(os.path.join(a.compare, "probes.csv")):
+        sys.exit(f"--compare: {os.path.join(a.compare, 'probes.csv')}: not found")
     if not a.no_run:
         run_scene(a, case)
     if not os.path.exists(os.path.join(a.out, "probes.csv")):
@@ -384,14 +400,17 @@ def main():
         window = None
         title = (f"dam-break-2d set-up, {a.walls} walls, spacing {a.spacing:g} m, against Martin & Moyce "
                  f"1952 [{case}]")
-    elif case is LOBOVSKY:
+    elif case in (LOBOVSKY, LOBOVSKY_GATE):
         sim, ref, _, window = compare_lobovsky(a.out, a.until)
-        title = (f"lobovsky-2014, 2D WCSPH, spacing {a.spacing:g} m (H / {0.3 / a.spacing:.0f}), "
+        title = (f"{case['scene']}, 2D WCSPH, spacing {a.spacing:g} m (H / {0.3 / a.spacing:.0f}), "
                  "against Lobovsky et al. 2014 (two series)")
     else:
         sim, ref, _, window = compare_spheric(a.out, a.until)
         title = f"spheric-test2, 3D WCSPH, spacing {a.spacing:g} m, against Kleefsman et al. 2005"
-    figure(a.figure or os.path.join(a.out, "validation.png"), case, sim, ref, window, title)
+    other = None
+    if a.compare:
+        other = (a.compare_label, read_table(os.path.join(a.compare, "probes.csv"))[1])
+    figure(a.figure or os.path.join(a.out, "validation.png"), case, sim, ref, window, title, other)
     return 0
 
 

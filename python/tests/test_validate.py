@@ -61,3 +61,23 @@ def test_compares_a_made_up_lobovsky_run(repo_root, tmp_path):
     assert abs(t_sim - t_exp - 0.01) < 0.002, line
     assert r.stdout.count("never in the run") == 2
     assert (tmp_path / "validation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_lobovsky_gate_compares_and_draws_a_second_run(repo_root, tmp_path):
+    # lobovsky-gate is compared like lobovsky; --compare draws another run's levels beside it and refuses
+    # a folder without probes.csv, or a case other than Lobovsky's.
+    rows = ["time,h_x0300,h_x0865,h_x1114,h_x1363"] + [f"{0.005 * k},0.3,0,0,0" for k in range(211)]
+    for d in ("gate", "instant"):
+        (tmp_path / d).mkdir()
+        (tmp_path / d / "probes.csv").write_text("\n".join(rows) + "\n")
+    script = os.path.join(repo_root, "scripts", "validate.py")
+    base = [sys.executable, script, "lobovsky-gate", "--no-run", "--out", str(tmp_path / "gate")]
+    r = subprocess.run(base + ["--compare", str(tmp_path / "instant")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count("never in the run") == 3
+    assert (tmp_path / "gate" / "validation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    r = subprocess.run(base + ["--compare", str(tmp_path / "missing")], capture_output=True, text=True)
+    assert r.returncode != 0 and "--compare" in r.stderr and "probes.csv" in r.stderr
+    r = subprocess.run([sys.executable, script, "martin-moyce-a", "--no-run", "--out", str(tmp_path / "gate"),
+                        "--compare", str(tmp_path / "instant")], capture_output=True, text=True)
+    assert r.returncode != 0 and "--compare" in r.stderr
