@@ -554,7 +554,12 @@ void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
     vec("force", p_.f[i]);
   else if (!std::isfinite(p_.rho[i]))
     os << "density = " << p_.rho[i];
-  else if (!std::isfinite(p_.p[i]))
+  else if (!(p_.rho[i] > 0)) {
+    os << "density = " << p_.rho[i] << " is not positive";
+    if (cfg_.density_evolution == DensityEvolution::Continuity && cfg_.model == Model::Wcsph)
+      os << " (the continuity density of a particle compressed and then torn apart: a smaller step, "
+            "more wall layers or summation density)";
+  } else if (!std::isfinite(p_.p[i]))
     os << "pressure = " << p_.p[i];
   else {
     vec("position", p_.x[i]);

@@ -210,6 +210,30 @@ TEST(Solver, UnstableRunStopsWithDiagnosis) {
   }
 }
 
+// A continuity density driven through zero stops the run naming the particle and the density (it once
+// went on, and the particle left through a wall a few steps later: SPHERIC Test 2 with Fourtakas).
+TEST(Solver, NonPositiveDensityStopsTheRun) {
+  auto cfg = base_config(Model::Wcsph);
+  cfg.density_evolution = DensityEvolution::Continuity;
+  cfg.phases[0].viscosity = 0;
+  cfg.time.dt = 1e-3;
+  Particles<2, double> p;
+  // Two particles 0.02 m apart flying apart at 100 m/s: d rho / dt = m v_ij . grad W ~ -4e6 kg/m^3/s.
+  add_particle<2, double>(p, V2{{0, 0}}, 0, ParticleKind::Fluid, 0, V2{{-100, 0}});
+  add_particle<2, double>(p, V2{{0.02, 0}}, 0, ParticleKind::Fluid, 0, V2{{100, 0}});
+  for (auto& r : p.rho) r = 1000;
+  Simulation<2, double> sim(cfg, p);
+  try {
+    sim.step();
+    FAIL() << "no SimulationError; density " << sim.particles().rho[0];
+  } catch (const SimulationError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("step 1 "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("particle 0 "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("is not positive"), std::string::npos) << msg;
+  }
+}
+
 TEST(Solver, RejectsBadInput) {
   auto cfg = base_config(Model::Wcsph);
   cfg.support = -1;
