@@ -1,5 +1,6 @@
 // Turning a mesh into particles (issue 13: a 100,000-triangle mesh into 10^6 particles, walls and fluid):
-// an icosphere of 81,920 triangles (level 6) written as a binary STL file, read (Assimp, welding),
+// icospheres of 81,920 and 327,680 triangles (levels 6 and 7, the benchmark's argument) written as binary
+// STL files, read (Assimp, welding),
 // checked closed, and sampled as a fluid volume of about 10^6 particles (radius 62 spacings) and as a
 // container's 3 wall layers outside it. Reported per stage; docs/benchmarks.md has the figures.
 #include <benchmark/benchmark.h>
@@ -65,12 +66,15 @@ struct TempFile {
   }
 };
 
-// The icosphere as a binary STL file in the temp folder (written once).
-const std::filesystem::path& stl_file() {
-  static const TempFile file{[] {
-    const auto m = icosphere(6);
-    const auto f =
-        std::filesystem::temp_directory_path() / ("cellsph-bench-" + std::to_string(getpid()) + ".stl");
+// The icosphere of `level` as a binary STL file in the temp folder (written once per level).
+const std::filesystem::path& stl_file(int level = 6) {
+  static std::map<int, TempFile> files;
+  auto& file = files[level];
+  if (!file.path.empty()) return file.path;
+  file.path = [level] {
+    const auto m = icosphere(level);
+    const auto f = std::filesystem::temp_directory_path() /
+                   ("cellsph-bench-" + std::to_string(getpid()) + "-" + std::to_string(level) + ".stl");
     std::ofstream out(f, std::ios::binary);
     char header[80] = "cellsph geometry_bench icosphere";
     out.write(header, 80);
@@ -87,7 +91,7 @@ const std::filesystem::path& stl_file() {
       out.write(reinterpret_cast<const char*>(&attr), 2);
     }
     return f;
-  }()};
+  }();
   return file.path;
 }
 
@@ -102,7 +106,7 @@ void BM_MeshReadAndCheck(benchmark::State& state) {
 void BM_MeshToParticles(benchmark::State& state) {
   std::size_t fluid = 0, walls = 0, triangles = 0;
   for (auto _ : state) {
-    TriangleMesh m = read_mesh_file(stl_file(), "icosphere.stl");
+    TriangleMesh m = read_mesh_file(stl_file(static_cast<int>(state.range(0))), "icosphere.stl");
     check_closed(m, "icosphere.stl");
     triangles = m.triangles.size();
     const Shape s = Shape::mesh(std::move(m), kSpacing);
@@ -116,7 +120,7 @@ void BM_MeshToParticles(benchmark::State& state) {
 }
 
 BENCHMARK(BM_MeshReadAndCheck)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_MeshToParticles)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MeshToParticles)->Arg(6)->Arg(7)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace cellsph::geometry
