@@ -229,10 +229,11 @@ double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, double spacing) {
 // falling onto itself while its pressure builds (and without the uniform pressure that the lattice
 // sum's bias gives with m = rho0 spacing^Dim). Blocks do not overlap; walls and obstacles above carry no
 // weight. A phase whose mass the scene sets keeps it.
-// DFSPH has no equation of state (its fluid is incompressible): there the masses stay those of the rest
-// density, and the particles start with the pressure p (and density rho0), which the first density solve
-// takes as its warm start. (The WCSPH masses compressed by whatever eos the scene holds made a DFSPH
-// column explode in its first steps: lobovsky-2014 switched to DFSPH lost a particle at t = 1 ms.)
+// DFSPH has no equation of state (its fluid is incompressible): there every mass is rho0 over the lattice
+// sum, so that the summation density of each lattice site is rho0 exactly, and the solver finds the
+// pressure itself. (The WCSPH masses compressed by whatever eos the scene holds made a DFSPH column
+// explode in its first steps: lobovsky-2014 switched to DFSPH lost a particle at t = 1 ms. Handing the
+// first solve rho0 g depth as a warm start was tried: 6 sweeps instead of 2, so it is not done.)
 template <int Dim, class Real>
 void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& cfg, double spacing,
                        const std::vector<bool>& mass_given, const std::vector<Aabb<Dim>>& blocks,
@@ -257,7 +258,6 @@ void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& c
     const bool incompressible = cfg.model == Model::Dfsph;
     const double rho =
         incompressible ? double(rho0) : double(cfg.eos.density(static_cast<Real>(pressure), rho0));
-    if (incompressible && p.p.size() == p.size()) p.p[i] = static_cast<Real>(pressure);
     p.m[i] = mass_given[ph] ? static_cast<Real>(double(cfg.phases[ph].mass) * rho / double(rho0))
                             : static_cast<Real>(rho * volume);
     // The continuity density starts from it (summation density recomputes it from the masses).
