@@ -8,7 +8,8 @@
 //
 // The state stays in the space between steps: every field of the particles (DeviceParticles, copied over
 // the field list), the solver's per-particle arrays, the rows. One value per step comes back to the host
-// (the reduction for dt), plus the stability check's first failing index and the row totals.
+// (the reduction for dt), plus the stability check's first failing index, the row totals and, with sinks,
+// the first fluid index in one (the Simulation then changes the count on the host and uploads again).
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -24,6 +25,7 @@
 #include "cellsph/solver/device/device_grid.hpp"
 #include "cellsph/solver/device/device_stepper_base.hpp"
 #include "cellsph/solver/device/memory_space.hpp"
+#include "cellsph/solver/emitters.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
 #include "cellsph/solver/models/continuity_density.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
@@ -56,6 +58,11 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     planes_.upload(cfg_.planes.data(), cfg_.planes.size());
     motions_.upload(cfg_.wall_motion.motions.data(), cfg_.wall_motion.motions.size());
     motion_rows_.upload(cfg_.wall_motion.rows.data(), cfg_.wall_motion.rows.size());
+    std::vector<EmitterPlane<Dim, Real>> emitters;
+    for (const Emitter& e : cfg_.inflow.emitters)
+      emitters.push_back(emitter_frame<Dim, Real>(e, cfg_.inflow.spacing, double(cfg_.support)));
+    emitters_.upload(emitters.data(), emitters.size());
+    sinks_.upload(cfg_.inflow.sinks.data(), cfg_.inflow.sinks.size());
   }
 
   void upload(const Particles<Dim, Real>& p) override {
@@ -89,13 +96,13 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   }
 
   void upload_wall_motion(const std::vector<std::uint32_t>& slot, const std::vector<V>& x0,
-                          const std::vector<std::int32_t>& motion) override {
+                          const std::vector<std::int32_t>& motion, const std::vector<V>& wall_a) override {
     CELLSPH_CHECK(slot.size() == x0.size() && slot.size() == motion.size(), "one entry per moving wall");
+    CELLSPH_CHECK(slot.empty() || wall_a.size() == n_, "one wall acceleration per particle");
     moving_.upload(slot.data(), slot.size());
     moving_x0_.upload(x0.data(), x0.size());
     moving_motion_.upload(motion.data(), motion.size());
-    wall_a_.resize(slot.empty() ? 0 : n_);
-    wall_a_.zero();
+    wall_a_.upload(wall_a.data(), slot.empty() ? 0 : n_);
   }
 
   void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
@@ -109,6 +116,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
 
     sw.reset();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
+    const bool holding = inflow_mark(in, fluid);
     if (cfg_.model == Model::Dfsph) {
       r.dt = dfsph(in, fluid);
       Ops::synchronize();
@@ -117,6 +125,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     } else {
       explicit_step(in, fluid, r, sw);
     }
+    if (holding)
+      run_pass(fluid, InflowHoldPass<Dim, Real>{d_.x.data(), d_.v.data(), held_.data(), held_x_.data(),
+                                                emitters_.data(), r.dt});
     const auto pv = view();
     if (cfg_.box.enabled || !cfg_.planes.empty()) {
       auto walls = box_plane_collisions(cfg_, pv);
@@ -132,6 +143,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
                                          moving_x0_.data(), moving_motion_.data(), motions_.data(),
                                          motion_rows_.data(), static_cast<double>(t)});
     }
+    if (sinks_.size() > 0)
+      r.first_in_sink =
+          first_where(fluid, InflowSinkTest<Dim, Real>{d_.x.data(), sinks_.data(), sinks_.size()});
     Ops::synchronize();
     r.integration_ms = sw.ms();
     return r;
@@ -191,6 +205,18 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   }
 
   bool paper() const { return cfg_.model == Model::PaperMultiphase; }
+
+  // Simulation::inflow_mark: the buffer of the emitters active at the step's start (in.emitters_active, the
+  // Simulation's flags); false when none is.
+  bool inflow_mark(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid) {
+    if (in.emitters_active == nullptr) return false;
+    emitter_active_.upload(in.emitters_active, emitters_.size());
+    held_.resize(n_);
+    held_x_.resize(n_);
+    run_pass(fluid, InflowMarkPass<Dim, Real>{d_.x.data(), held_.data(), held_x_.data(), emitters_.data(),
+                                              emitter_active_.data(), emitters_.size()});
+    return true;
+  }
 
   // WCSPH or the paper's model (Simulation::step's sequence): density, wall states, forces, dt, integration.
   void explicit_step(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid,
@@ -358,6 +384,13 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<std::uint32_t> moving_;
   Array<V> moving_x0_, wall_a_;
   Array<std::int32_t> moving_motion_;
+  // Emitters and sinks (emitters.hpp): the emitters' planes and the sinks (from the config); per emitter
+  // whether it is active this step; per particle its emitter or -1 and its start position (the buffer).
+  Array<EmitterPlane<Dim, Real>> emitters_;
+  Array<Sink> sinks_;
+  Array<std::uint8_t> emitter_active_;
+  Array<std::int32_t> held_;
+  Array<V> held_x_;
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;
   Array<V> xs_;
