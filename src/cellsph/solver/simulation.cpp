@@ -258,8 +258,10 @@ void Simulation<Dim, Real>::advance_bodies(Real dt) {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::restore_bodies(std::vector<RigidBodyState> states, const std::string& source) {
   bodies_.set_states(std::move(states), source);
+  sync_host();  // a device backend: its particles here, the bodies placed among them, all back there
   bodies_.place(p_.x, p_.v, wall_a_);
   lists_valid_ = false;
+  if (device_) upload_to_device();
 }
 
 template <int Dim, class Real>
@@ -1007,9 +1009,6 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
     return;
   }
   require_backend(b, "solver.backend");
-  if (bodies_.any())
-    throw InputError("solver.backend " + std::string(backend_name(b)) +
-                     ": floating bodies (bodies) run on the CPU backend only");
   if (const std::string why = device_step_unsupported(cfg_); !why.empty())
     throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
   sync_host();
@@ -1024,7 +1023,9 @@ void Simulation<Dim, Real>::upload_to_device() {
   device_->upload(p_);
   if (cfg_.wall_model == WallModel::Dynamic && !boundary_.empty())
     device_->upload_wall_self_density(wall_self_rho_);
-  if (!moving_.empty()) device_->upload_wall_motion(moving_, moving_x0_, moving_motion_, wall_a_);
+  if (!moving_.empty() || !wall_a_.empty())
+    device_->upload_wall_motion(moving_, moving_x0_, moving_motion_, wall_a_);
+  if (bodies_.any()) device_->upload_bodies(bodies_);
   if (cfg_.model == Model::Dfsph) device_->upload_solver_state(state_);
 }
 
@@ -1053,6 +1054,14 @@ void Simulation<Dim, Real>::step_device() {
   time_ += r.dt;
   last_dt_ = r.dt;
   ++steps_;
+  if (bodies_.any()) {
+    // The loads from the device's per-particle forces, summed here in the CPU's order; the rigid step
+    // here (also placing the host's copy of their particles and accelerations), the placement there.
+    device_->download_body_forces(body_f_, body_x_);
+    bodies_.sum_loads(body_f_, body_x_);
+    advance_bodies(r.dt);
+    device_->place_bodies(bodies_.states());
+  }
   inflow_end_step(r.dt, r.first_in_sink >= 0);
 }
 

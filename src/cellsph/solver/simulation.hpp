@@ -299,8 +299,11 @@ class Simulation {
   std::vector<V> moving_x0_;
   std::vector<std::int32_t> moving_motion_;
   std::vector<V> wall_a_;
-  // Floating bodies (config rigid_bodies): their particles' slots, offsets, states and loads.
+  // Floating bodies (config rigid_bodies): their particles' slots, offsets, states and loads; with a device
+  // backend, per body particle the force and position the device computed in the step.
   RigidBodySystem<Dim, Real> bodies_;
+  std::vector<Vec<Dim, double>> body_f_;
+  std::vector<V> body_x_;
 
   // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
   // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/particles.hpp"
 
@@ -77,6 +78,15 @@ class DeviceStepperBase {
                                   const std::vector<Vec<Dim, Real>>& x0,
                                   const std::vector<std::int32_t>& motion,
                                   const std::vector<Vec<Dim, Real>>& wall_a) = 0;
+  // Floating bodies (boundary/rigid_bodies.hpp), after upload(): their particles' slots, bodies and
+  // offsets, per particle its body, per body its mass per particle, the contact constants. Their particles
+  // get rows like the fluid's (within h: the fluid the reaction reads and the walls a contact reads).
+  virtual void upload_bodies(const RigidBodySystem<Dim, Real>& bodies) = 0;
+  // After step(): per body particle its force of the step (BodyReactionPass after the fluid's forces, plus
+  // BodyContactPass) and its position (the step's start: body particles move only in place_bodies).
+  virtual void download_body_forces(std::vector<Vec<Dim, double>>& f, std::vector<Vec<Dim, Real>>& x) = 0;
+  // The body particles where `states` put them (BodyPlacePass: position, velocity, wall acceleration).
+  virtual void place_bodies(const std::vector<RigidBodyState>& states) = 0;
   // One step of Simulation::step() with a global step: the emitters' buffer marked, neighbour rows,
   // density, wall states, forces (WCSPH or the paper's model), dt, integration (symplectic Euler or the
   // paper's leap-frog), the buffer held, box and planes, the stability check, the moving walls at the new
@@ -93,6 +103,9 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
+  if (cfg.rigid_bodies.any() && !(cfg.rigid_bodies.contact_distance < double(cfg.support)))
+    return "floating bodies on a device need body_contact.distance below the support h (the device's rows "
+           "of body particles reach h)";
   return {};
 }
 
