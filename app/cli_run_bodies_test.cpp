@@ -62,13 +62,19 @@ TEST(CliRunBodies, AResumedRunWritesTheSameFileAsAnUninterruptedOne) {
   EXPECT_EQ(read_file(dir / "a" / "frame_00006.csv"), read_file(dir / "b" / "frame_00006.csv"));
 }
 
-TEST(CliRunBodies, TheDeviceBackendIsRefused) {
+// The host-emulated device (the CUDA backend's code path on the CPU): the CPU's bodies.csv and frames.
+TEST(CliRunBodies, TheHostDeviceWritesTheCpusFiles) {
   TempDir dir;
-  const auto r =
-      run_cli(dir, "run floating-box --until 0.1 --backend host-device --quiet --out " + q(dir / "out"));
-  EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("floating bodies run on the CPU"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(dir / "out"));
+  const std::string common = " --until 0.05 --format csv --fps 40 --quiet" + kCoarse;
+  for (const std::string backend : {"cpu", "host-device"}) {
+    const auto r =
+        run_cli(dir, "run floating-box --backend " + backend + " --out " + q(dir / backend) + common);
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  const std::string a = read_file(dir / "cpu" / "bodies.csv");
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, read_file(dir / "host-device" / "bodies.csv"));
+  EXPECT_EQ(read_file(dir / "cpu" / "frame_00002.csv"), read_file(dir / "host-device" / "frame_00002.csv"));
 }
 
 }  // namespace

@@ -134,8 +134,6 @@ void SolverConfig<Dim, Real>::validate() const {
           "floating bodies need the WCSPH model (solver.model = wcsph): their force is its wall term");
     if (time.mode == TimeStepping::PerParticle)
       bad("time.mode", "per-particle", "floating bodies need global time steps (fixed or courant)");
-    if (backend != Backend::Cpu)
-      bad("backend", backend_name(backend), "floating bodies run on the CPU only (solver.backend = cpu)");
     if (wall_model == WallModel::Dynamic)
       bad("boundary.model", "dynamic",
           "floating bodies need akinci or adami walls (dynamic walls keep a wall-wall density of walls at "

@@ -56,18 +56,29 @@ struct Inflow {
   [[nodiscard]] bool any() const { return !emitters.empty() || !sinks.empty(); }
 };
 
-// An emitter ready for the step: unit normal n, tangents, the layer's lattice offsets (relative to the
-// centre, in the plane), the buffer depth.
+// An emitter's plane and buffer, as the passes read them (plain data: a device holds a copy): unit normal
+// n, tangents, the buffer depth.
 template <int Dim, class Real>
-struct EmitterFrame {
+struct EmitterPlane {
   using V = Vec<Dim, Real>;
   V center{}, normal{}, velocity{};  // velocity = U n
   V tangent[Dim - 1]{};
   Real half[2] = {0, 0};  // half the cross-section along each tangent (disc: radius in half[0])
   bool disc = false;
   Real depth = 0, spacing = 0;
-  std::vector<V> layer;  // offsets of one layer's particles from the centre
 };
+
+// An emitter ready for the step: its plane and the layer's lattice offsets (relative to the centre, in
+// the plane).
+template <int Dim, class Real>
+struct EmitterFrame : EmitterPlane<Dim, Real> {
+  std::vector<Vec<Dim, Real>> layer;  // offsets of one layer's particles from the centre
+};
+
+// True when emitter e is active at time t (its buffer is held and it emits): start <= t < end.
+inline bool emitter_active(const Emitter& e, double t) {
+  return t >= e.start && t < e.end;
+}
 
 // Empty when `in` is valid for a `dim`-D scene with `phases` phases; otherwise "KEY: VALUE: why".
 std::string inflow_config_error(const Inflow& in, int dim, std::size_t phases);
@@ -80,7 +91,7 @@ EmitterFrame<Dim, Real> emitter_frame(const Emitter& e, double spacing, double s
 
 // True when x is in the buffer of emitter f: -spacing <= (x - c).n < depth, inside the cross-section.
 template <int Dim, class Real>
-CELLSPH_HD inline bool in_emitter_buffer(const EmitterFrame<Dim, Real>& f, const Vec<Dim, Real>& x) {
+CELLSPH_HD inline bool in_emitter_buffer(const EmitterPlane<Dim, Real>& f, const Vec<Dim, Real>& x) {
   const Vec<Dim, Real> r = x - f.center;
   const Real d = dot(r, f.normal);
   if (!(d >= -f.spacing && d < f.depth)) return false;
@@ -97,13 +108,15 @@ CELLSPH_HD inline bool in_sink(const Sink& s, const Vec<Dim, Real>& x) {
   return true;
 }
 
-// Marks the fluid particles in the buffer of an active emitter: held[i] = emitter index or -1. Runs
-// over the fluid set at the start of a step (frames: the active emitters' frames, -1 entries skipped).
+// Marks the fluid particles in the buffer of an active emitter: held[i] = emitter index or -1, and a held
+// particle's position at the step's start in x_start[i]. Runs over the fluid set at the start of a step
+// (frames: every emitter's plane; those with active[e] == 0 are skipped).
 template <int Dim, class Real>
 struct InflowMarkPass {
   const Vec<Dim, Real>* x;
   std::int32_t* held;
-  const EmitterFrame<Dim, Real>* frames;
+  Vec<Dim, Real>* x_start;
+  const EmitterPlane<Dim, Real>* frames;
   const std::uint8_t* active;
   std::size_t count;
   CELLSPH_HD void operator()(std::size_t i) const {
@@ -111,40 +124,49 @@ struct InflowMarkPass {
     for (std::size_t e = 0; e < count; ++e)
       if (active[e] && in_emitter_buffer(frames[e], x[i])) {
         held[i] = static_cast<std::int32_t>(e);
+        x_start[i] = x[i];
         return;
       }
   }
 };
 
-// After the integration: held particle slot[k] is put at x_start[k] + U n dt with velocity U n.
+// After the integration, over the same fluid set: a held particle is put at x_start + U n dt with
+// velocity U n.
 template <int Dim, class Real>
 struct InflowHoldPass {
   Vec<Dim, Real>* x;
   Vec<Dim, Real>* v;
-  const std::uint32_t* slot;
+  const std::int32_t* held;
   const Vec<Dim, Real>* x_start;
-  const std::int32_t* emitter;
-  const EmitterFrame<Dim, Real>* frames;
+  const EmitterPlane<Dim, Real>* frames;
   Real dt;
-  CELLSPH_HD void operator()(std::size_t k) const {
-    const auto& f = frames[emitter[k]];
-    x[slot[k]] = x_start[k] + f.velocity * dt;
-    v[slot[k]] = f.velocity;
+  CELLSPH_HD void operator()(std::size_t i) const {
+    if (held[i] < 0) return;
+    const auto& f = frames[held[i]];
+    x[i] = x_start[i] + f.velocity * dt;
+    v[i] = f.velocity;
+  }
+};
+
+// True for a particle inside one of the sinks (run over the fluid set at the end of a step).
+template <int Dim, class Real>
+struct InflowSinkTest {
+  const Vec<Dim, Real>* x;
+  const Sink* sinks;
+  std::size_t count;
+  CELLSPH_HD bool operator()(std::size_t i) const {
+    for (std::size_t k = 0; k < count; ++k)
+      if (in_sink<Dim, Real>(sinks[k], x[i])) return true;
+    return false;
   }
 };
 
 // keep[i] = 0 for a fluid particle inside a sink, 1 otherwise (the end of a step).
 template <int Dim, class Real>
 struct InflowSinkPass {
-  const Vec<Dim, Real>* x;
+  InflowSinkTest<Dim, Real> test;
   std::uint8_t* keep;
-  const Sink* sinks;
-  std::size_t count;
-  CELLSPH_HD void operator()(std::size_t i) const {
-    keep[i] = 1;
-    for (std::size_t k = 0; k < count; ++k)
-      if (in_sink<Dim, Real>(sinks[k], x[i])) keep[i] = 0;
-  }
+  CELLSPH_HD void operator()(std::size_t i) const { keep[i] = test(i) ? 0 : 1; }
 };
 
 // Advances the emitter's `advance` by U dt and appends to `out` the positions of the layers due

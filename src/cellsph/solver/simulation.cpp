@@ -122,6 +122,7 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
                        std::to_string(phase.mass) + " (phases[" + std::to_string(e.phase) +
                        "].mass): emitted particles need one > 0");
     frames_.push_back(emitter_frame<Dim, Real>(e, cfg_.inflow.spacing, double(cfg_.support)));
+    emitter_planes_.push_back(frames_.back());
     advance_.push_back(cfg_.inflow.spacing);
   }
   // Moving walls: each particle's motion and initial position, kept by id (the input order's index is
@@ -257,8 +258,10 @@ void Simulation<Dim, Real>::advance_bodies(Real dt) {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::restore_bodies(std::vector<RigidBodyState> states, const std::string& source) {
   bodies_.set_states(std::move(states), source);
+  sync_host();  // a device backend: its particles here, the bodies placed among them, all back there
   bodies_.place(p_.x, p_.v, wall_a_);
   lists_valid_ = false;
+  if (device_) upload_to_device();
 }
 
 template <int Dim, class Real>
@@ -674,7 +677,7 @@ void Simulation<Dim, Real>::step() {
   ++steps_;
   move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
   if (bodies_.any()) advance_bodies(dt);
-  inflow_end_step(dt);
+  inflow_end_step(dt, true);
   timings_.integration += sw.ms();
 }
 
@@ -700,7 +703,7 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   last_dt_ = dt;
   ++steps_;
   move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
-  inflow_end_step(dt);
+  inflow_end_step(dt, true);
   timings_.integration += sw.ms();
 }
 
@@ -719,58 +722,47 @@ void Simulation<Dim, Real>::rebuild_kind_lists() {
   lists_valid_ = false;
 }
 
+// Which emitters are active at the step's start (active_); true when one is.
+template <int Dim, class Real>
+bool Simulation<Dim, Real>::inflow_activity() {
+  active_.assign(frames_.size(), 0);
+  bool any = false;
+  for (std::size_t e = 0; e < frames_.size(); ++e) {
+    active_[e] = emitter_active(cfg_.inflow.emitters[e], double(time_)) ? 1 : 0;
+    any = any || active_[e];
+  }
+  return any;
+}
+
 // The fluid particles in the buffer of an emitter active at the step's start (emitters.hpp), with their
 // positions at that time.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::inflow_mark() {
-  held_.clear();
-  held_x_.clear();
-  held_emitter_.clear();
-  if (frames_.empty()) return;
-  active_.assign(frames_.size(), 0);
-  bool any = false;
-  for (std::size_t e = 0; e < frames_.size(); ++e) {
-    const Emitter& em = cfg_.inflow.emitters[e];
-    active_[e] = double(time_) >= em.start && double(time_) < em.end ? 1 : 0;
-    any = any || active_[e];
-  }
-  if (!any) return;
+  holding_ = inflow_activity();
+  if (!holding_) return;
   held_of_.resize(p_.size());
-  run_pass(fluid_, InflowMarkPass<Dim, Real>{p_.x.data(), held_of_.data(), frames_.data(), active_.data(),
-                                             frames_.size()});
-  for (const std::uint32_t i : fluid_)
-    if (held_of_[i] >= 0) {
-      held_.push_back(i);
-      held_x_.push_back(p_.x[i]);
-      held_emitter_.push_back(held_of_[i]);
-    }
+  held_x_.resize(p_.size());
+  run_pass(fluid_, InflowMarkPass<Dim, Real>{p_.x.data(), held_of_.data(), held_x_.data(),
+                                             emitter_planes_.data(), active_.data(), frames_.size()});
 }
 
 template <int Dim, class Real>
 void Simulation<Dim, Real>::inflow_hold(Real dt) {
-  if (held_.empty()) return;
-  run_pass(held_.size(), InflowHoldPass<Dim, Real>{p_.x.data(), p_.v.data(), held_.data(), held_x_.data(),
-                                                   held_emitter_.data(), frames_.data(), dt});
+  if (!holding_) return;
+  run_pass(fluid_, InflowHoldPass<Dim, Real>{p_.x.data(), p_.v.data(), held_of_.data(), held_x_.data(),
+                                             emitter_planes_.data(), dt});
 }
 
 // After the step: the sinks' particles are removed, then the layers due are appended (oldest first, emitter
 // by emitter), with new ids. An emitted particle is fluid of the emitter's phase at rest density and zero
 // pressure, moving at U along the normal (the paper model's half-step velocity too), with zero solver state.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::inflow_end_step(Real dt) {
+void Simulation<Dim, Real>::inflow_end_step(Real dt, bool maybe_in_sink) {
   if (!cfg_.inflow.any()) return;
-  const std::size_t n = p_.size();
-  std::vector<std::uint8_t> keep;
-  if (!cfg_.inflow.sinks.empty()) {
-    keep.assign(n, 1);
-    run_pass(fluid_, InflowSinkPass<Dim, Real>{p_.x.data(), keep.data(), cfg_.inflow.sinks.data(),
-                                               cfg_.inflow.sinks.size()});
-    if (std::find(keep.begin(), keep.end(), std::uint8_t{0}) == keep.end()) keep.clear();
-  }
   std::vector<V> xs;
   std::vector<std::int32_t> emitter_of;
   for (std::size_t e = 0; e < frames_.size(); ++e) {
-    if (!active_[e]) continue;  // active at the step's start (inflow_mark)
+    if (!active_[e]) continue;  // active at the step's start (inflow_activity)
     // The buffer moves U dt a step: more than a few spacings means a fixed step far too long for the inflow
     // (the Courant step keeps it below one), and a runaway count; stop with the numbers.
     const double travel = cfg_.inflow.emitters[e].velocity * double(dt);
@@ -780,6 +772,17 @@ void Simulation<Dim, Real>::inflow_end_step(Real dt) {
                             std::to_string(cfg_.inflow.spacing) + " m): shorten the time step");
     emit_layers(frames_[e], cfg_.inflow.emitters[e].velocity, double(dt), advance_[e], xs);
     emitter_of.resize(xs.size(), static_cast<std::int32_t>(e));
+  }
+  if (xs.empty() && !maybe_in_sink) return;
+  // A device backend: the count changes here, on the host, from the device's particles (put back below).
+  sync_host();
+  const std::size_t n = p_.size();
+  std::vector<std::uint8_t> keep;
+  if (!cfg_.inflow.sinks.empty()) {
+    keep.assign(n, 1);
+    run_pass(fluid_, InflowSinkPass<Dim, Real>{
+                         {p_.x.data(), cfg_.inflow.sinks.data(), cfg_.inflow.sinks.size()}, keep.data()});
+    if (std::find(keep.begin(), keep.end(), std::uint8_t{0}) == keep.end()) keep.clear();
   }
   if (keep.empty() && xs.empty()) return;
   if (next_id_ + xs.size() > std::uint64_t{std::numeric_limits<std::uint32_t>::max()} + 1)
@@ -806,6 +809,7 @@ void Simulation<Dim, Real>::inflow_end_step(Real dt) {
   rebuild_kind_lists();
   set_moving_slots();
   move_walls(time_);
+  if (device_) upload_to_device();  // everything the device holds, at the new count
 }
 
 // Stable compaction by `keep`, then `added` zero entries, in every array of one entry per particle (those
@@ -839,7 +843,6 @@ void Simulation<Dim, Real>::change_count(const std::vector<std::uint8_t>& keep, 
   edit(df_alpha_);
   edit(df_kappa_);
   edit(within_count_);
-  edit(held_of_);
   lists_valid_ = false;
 }
 
@@ -1023,15 +1026,13 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
   if (b == backend_) return;
   if (b == Backend::Cpu) {
     sync_host();
+    move_walls(time_);  // their accelerations (wall_a_, not a particle field) at the device's clock
     device_.reset();
     backend_ = b;
     lists_valid_ = false;
     return;
   }
   require_backend(b, "solver.backend");
-  if (bodies_.any())
-    throw InputError("solver.backend " + std::string(backend_name(b)) +
-                     ": floating bodies (bodies) run on the CPU backend only");
   if (const std::string why = device_step_unsupported(cfg_); !why.empty())
     throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
   sync_host();
@@ -1046,7 +1047,9 @@ void Simulation<Dim, Real>::upload_to_device() {
   device_->upload(p_);
   if (cfg_.wall_model == WallModel::Dynamic && !boundary_.empty())
     device_->upload_wall_self_density(wall_self_rho_);
-  if (!moving_.empty()) device_->upload_wall_motion(moving_, moving_x0_, moving_motion_);
+  if (!moving_.empty() || !wall_a_.empty())
+    device_->upload_wall_motion(moving_, moving_x0_, moving_motion_, wall_a_);
+  if (bodies_.any()) device_->upload_bodies(bodies_);
   if (cfg_.model == Model::Dfsph) device_->upload_solver_state(state_);
 }
 
@@ -1055,6 +1058,7 @@ void Simulation<Dim, Real>::upload_to_device() {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step_device() {
   DeviceStepInput<Real> in{time_, last_dt_, leapfrog_started_};
+  if (inflow_activity()) in.emitters_active = active_.data();
   if (cfg_.model == Model::Dfsph) {
     if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);  // m, rho0: on the host
     in.step = steps_ + 1;
@@ -1074,6 +1078,15 @@ void Simulation<Dim, Real>::step_device() {
   time_ += r.dt;
   last_dt_ = r.dt;
   ++steps_;
+  if (bodies_.any()) {
+    // The loads from the device's per-particle forces, summed here in the CPU's order; the rigid step
+    // here (also placing the host's copy of their particles and accelerations), the placement there.
+    device_->download_body_forces(body_f_, body_x_);
+    bodies_.sum_loads(body_f_, body_x_);
+    advance_bodies(r.dt);
+    device_->place_bodies(bodies_.states());
+  }
+  inflow_end_step(r.dt, r.first_in_sink >= 0);
 }
 
 template <int Dim, class Real>

@@ -212,11 +212,15 @@ class Simulation {
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
   // ties by id; every per-particle array is permuted and the Verlet lists invalidated.
   void reorder_slots(const IndexList& slots);
-  // Emitters and sinks (emitters.hpp): mark the buffer's particles at the start of a step, hold them after
-  // the integration, then emit layers and remove the sinks' particles at the end of the step.
+  // Emitters and sinks (emitters.hpp): which emitters are active at the step's start (inflow_activity),
+  // mark the buffer's particles then, hold them after the integration, then emit layers and remove the
+  // sinks' particles at the end of the step. maybe_in_sink: false when the device found no fluid particle in
+  // a sink (the count then changes only when a layer is due; with a device backend a change copies the
+  // particles here and back).
+  bool inflow_activity();
   void inflow_mark();
   void inflow_hold(Real dt);
-  void inflow_end_step(Real dt);
+  void inflow_end_step(Real dt, bool maybe_in_sink);
   // Removes the particles with keep[i] == 0 (stable; keep empty: none) and appends `added` particles
   // (zero-filled, for the caller to set), in every per-particle array; rebuilds the kind lists.
   void change_count(const std::vector<std::uint8_t>& keep, std::size_t added);
@@ -303,8 +307,11 @@ class Simulation {
   std::vector<V> moving_x0_;
   std::vector<std::int32_t> moving_motion_;
   std::vector<V> wall_a_;
-  // Floating bodies (config rigid_bodies): their particles' slots, offsets, states and loads.
+  // Floating bodies (config rigid_bodies): their particles' slots, offsets, states and loads; with a device
+  // backend, per body particle the force and position the device computed in the step.
   RigidBodySystem<Dim, Real> bodies_;
+  std::vector<Vec<Dim, double>> body_f_;
+  std::vector<V> body_x_;
 
   // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
   // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.
@@ -318,15 +325,16 @@ class Simulation {
   DfsphStats dfsph_stats_;
 
   // Emitters and sinks (config inflow, emitters.hpp): each emitter's frame and layer lattice (from the
-  // config), its `advance` and the next free id (integrator state, checkpointed); the step's held
-  // buffer particles (slot, start position, emitter), rebuilt every step.
+  // config) and its plane as the passes read it, its `advance` and the next free id (integrator state,
+  // checkpointed); the step's buffer (per particle its emitter or -1 and its start position; valid for the
+  // fluid slots while holding_), rebuilt every step; which emitters are active at the step's start.
   std::vector<EmitterFrame<Dim, Real>> frames_;
+  std::vector<EmitterPlane<Dim, Real>> emitter_planes_;
   std::vector<double> advance_;
   std::uint64_t next_id_ = 0;
   std::vector<std::int32_t> held_of_;
-  IndexList held_;
   std::vector<V> held_x_;
-  std::vector<std::int32_t> held_emitter_;
+  bool holding_ = false;
   std::vector<std::uint8_t> active_;
 };
 

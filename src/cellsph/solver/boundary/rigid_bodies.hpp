@@ -225,6 +225,33 @@ class RigidBodySystem {
   // the body particles' candidate rows; `forces`: the WCSPH force pass.
   template <class ForcesPass>
   void compute_loads(const ParticleView<Dim, Real>& pv, const ForcesPass& forces);
+  // The same sums from forces computed elsewhere (a device): per body particle k its force f[k] (the two
+  // passes' sum) and its position x[k].
+  void sum_loads(const std::vector<Vec<Dim, double>>& f, const std::vector<V>& x) {
+    f_ = f;
+    add_loads([&](std::size_t k) { return x[k]; });
+  }
+  // The contact pass over the body particles slot[k] with this system's constants, over the given arrays
+  // (host or device: slot, body_of_slot, mass_per_particle as those below).
+  [[nodiscard]] BodyContactPass<Dim, Real> contact_pass(const ParticleView<Dim, Real>& pv,
+                                                        const std::uint32_t* slot,
+                                                        const std::int32_t* body_of_slot,
+                                                        const double* mass_per_particle,
+                                                        Vec<Dim, double>* out) const {
+    const double w = frequency_;
+    return {pv,
+            slot,
+            body_of_slot,
+            mass_per_particle,
+            cfg_->contact_distance,
+            w * w,
+            2 * cfg_->contact_damping * w,
+            out};
+  }
+  // Per body particle k its body and its offset in the body frame; per body its mass per particle.
+  [[nodiscard]] const std::vector<std::int32_t>& body_of_body_particle() const { return body_; }
+  [[nodiscard]] const std::vector<std::array<double, 3>>& offsets() const { return r0_; }
+  [[nodiscard]] const std::vector<double>& mass_per_particle() const { return mass_per_particle_; }
   // One symplectic Euler step of dt under gravity g and loads().
   void advance(double dt, const V& g);
   // The body particles where the bodies are (BodyPlacePass).
@@ -235,6 +262,10 @@ class RigidBodySystem {
   [[nodiscard]] std::array<double, 3> momentum() const;
 
  private:
+  // loads() from f_ and the body particles' positions x_of(k), serially in slot order.
+  template <class PositionOf>
+  void add_loads(const PositionOf& x_of);
+
   const RigidBodies* cfg_ = nullptr;
   double frequency_ = 0;
   std::vector<std::int32_t> body_of_id_;
@@ -266,11 +297,14 @@ void RigidBodySystem<Dim, Real>::compute_loads(const ParticleView<Dim, Real>& pv
   // Per particle in parallel (each writes its own entry), then summed serially in slot order: the same
   // bits for any thread count.
   run_pass(slot_.size(), BodyReactionPass<Dim, Real, ForcesPass>{pv, forces, slot_.data(), f_.data()});
-  const RigidBodies& c = *cfg_;
-  const double w = frequency_;
   run_pass(slot_.size(),
-           BodyContactPass<Dim, Real>{pv, slot_.data(), body_of_slot_.data(), mass_per_particle_.data(),
-                                      c.contact_distance, w * w, 2 * c.contact_damping * w, f_.data()});
+           contact_pass(pv, slot_.data(), body_of_slot_.data(), mass_per_particle_.data(), f_.data()));
+  add_loads([&](std::size_t k) { return pv.x[slot_[k]]; });
+}
+
+template <int Dim, class Real>
+template <class PositionOf>
+void RigidBodySystem<Dim, Real>::add_loads(const PositionOf& x_of) {
   loads_.assign(states_.size(), RigidBodyLoad{});
   for (std::size_t k = 0; k < slot_.size(); ++k) {
     RigidBodyLoad& l = loads_[static_cast<std::size_t>(body_[k])];
@@ -278,7 +312,7 @@ void RigidBodySystem<Dim, Real>::compute_loads(const ParticleView<Dim, Real>& pv
     double f[3] = {0, 0, 0}, r[3] = {0, 0, 0}, t[3];
     for (int a = 0; a < Dim; ++a) {
       f[a] = f_[k][a];
-      r[a] = static_cast<double>(pv.x[slot_[k]][a]) - s.x[a];
+      r[a] = static_cast<double>(x_of(k)[a]) - s.x[a];
     }
     body_detail::cross(r, f, t);
     for (int a = 0; a < 3; ++a) {

@@ -8,10 +8,13 @@
 //
 // The state stays in the space between steps: every field of the particles (DeviceParticles, copied over
 // the field list), the solver's per-particle arrays, the rows. One value per step comes back to the host
-// (the reduction for dt), plus the stability check's first failing index and the row totals.
+// (the reduction for dt), plus the stability check's first failing index, the row totals and, with sinks,
+// the first fluid index in one (the Simulation then changes the count on the host and uploads again).
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "cellsph/core/error.hpp"
@@ -24,6 +27,7 @@
 #include "cellsph/solver/device/device_grid.hpp"
 #include "cellsph/solver/device/device_stepper_base.hpp"
 #include "cellsph/solver/device/memory_space.hpp"
+#include "cellsph/solver/emitters.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
 #include "cellsph/solver/models/continuity_density.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
@@ -56,6 +60,11 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     planes_.upload(cfg_.planes.data(), cfg_.planes.size());
     motions_.upload(cfg_.wall_motion.motions.data(), cfg_.wall_motion.motions.size());
     motion_rows_.upload(cfg_.wall_motion.rows.data(), cfg_.wall_motion.rows.size());
+    std::vector<EmitterPlane<Dim, Real>> emitters;
+    for (const Emitter& e : cfg_.inflow.emitters)
+      emitters.push_back(emitter_frame<Dim, Real>(e, cfg_.inflow.spacing, double(cfg_.support)));
+    emitters_.upload(emitters.data(), emitters.size());
+    sinks_.upload(cfg_.inflow.sinks.data(), cfg_.inflow.sinks.size());
   }
 
   void upload(const Particles<Dim, Real>& p) override {
@@ -71,6 +80,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     }
     fluid_.upload(fluid.data(), fluid.size());
     boundary_.upload(boundary.data(), boundary.size());
+    fluid_host_ = std::move(fluid);
+    row_set_.resize(0);  // the fluid's rows, until upload_bodies
+    body_slot_.resize(0);
     rho0_.upload(rho0.data(), n_);
     wall_states_ = cfg_.wall_model != WallModel::Akinci && !boundary.empty();
     for (auto* a : {&vol_, &prho2_, &drho_}) {
@@ -89,13 +101,47 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   }
 
   void upload_wall_motion(const std::vector<std::uint32_t>& slot, const std::vector<V>& x0,
-                          const std::vector<std::int32_t>& motion) override {
+                          const std::vector<std::int32_t>& motion, const std::vector<V>& wall_a) override {
     CELLSPH_CHECK(slot.size() == x0.size() && slot.size() == motion.size(), "one entry per moving wall");
+    CELLSPH_CHECK(wall_a.empty() || wall_a.size() == n_, "one wall acceleration per particle");
     moving_.upload(slot.data(), slot.size());
     moving_x0_.upload(x0.data(), x0.size());
     moving_motion_.upload(motion.data(), motion.size());
-    wall_a_.resize(slot.empty() ? 0 : n_);
-    wall_a_.zero();
+    wall_a_.upload(wall_a.data(), wall_a.size());
+  }
+
+  void upload_bodies(const RigidBodySystem<Dim, Real>& b) override {
+    const auto& slot = b.slots();
+    CELLSPH_CHECK(b.body_of_slot().size() == n_, "one body index per particle");
+    body_slot_.upload(slot.data(), slot.size());
+    body_of_.upload(b.body_of_body_particle().data(), slot.size());
+    body_r0_.upload(b.offsets().data(), slot.size());
+    body_of_slot_.upload(b.body_of_slot().data(), n_);
+    body_mpp_.upload(b.mass_per_particle().data(), b.mass_per_particle().size());
+    body_f_.resize(slot.size());
+    body_x_.resize(slot.size());
+    contact_ = b.contact_pass({}, body_slot_.data(), body_of_slot_.data(), body_mpp_.data(), body_f_.data());
+    // Rows for the fluid and the body particles, ascending.
+    std::vector<std::uint32_t> set(fluid_host_.size() + slot.size());
+    std::merge(fluid_host_.begin(), fluid_host_.end(), slot.begin(), slot.end(), set.begin());
+    row_set_.upload(set.data(), set.size());
+  }
+
+  void download_body_forces(std::vector<Vec<Dim, double>>& f, std::vector<V>& x) override {
+    f.resize(body_f_.size());
+    body_f_.download(f.data());
+    run_pass(DeviceRange<Space>{body_slot_.size()},
+             GatherPositionsPass<Dim, Real>{d_.x.data(), body_slot_.data(), body_x_.data()});
+    x.resize(body_x_.size());
+    body_x_.download(x.data());
+  }
+
+  void place_bodies(const std::vector<RigidBodyState>& states) override {
+    body_states_.upload(states.data(), states.size());
+    run_pass(
+        DeviceRange<Space>{body_slot_.size()},
+        BodyPlacePass<Dim, Real>{d_.x.data(), d_.v.data(), wall_a_.size() > 0 ? wall_a_.data() : nullptr,
+                                 body_slot_.data(), body_of_.data(), body_r0_.data(), body_states_.data()});
   }
 
   void download(Particles<Dim, Real>& p) override { download_particles(d_, p); }
@@ -109,6 +155,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
 
     sw.reset();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
+    const bool holding = inflow_mark(in, fluid);
     if (cfg_.model == Model::Dfsph) {
       r.dt = dfsph(in, fluid);
       Ops::synchronize();
@@ -117,6 +164,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     } else {
       explicit_step(in, fluid, r, sw);
     }
+    if (holding)
+      run_pass(fluid, InflowHoldPass<Dim, Real>{d_.x.data(), d_.v.data(), held_.data(), held_x_.data(),
+                                                emitters_.data(), r.dt});
     const auto pv = view();
     if (cfg_.box.enabled || !cfg_.planes.empty()) {
       auto walls = box_plane_collisions(cfg_, pv);
@@ -132,6 +182,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
                                          moving_x0_.data(), moving_motion_.data(), motions_.data(),
                                          motion_rows_.data(), static_cast<double>(t)});
     }
+    if (sinks_.size() > 0)
+      r.first_in_sink =
+          first_where(fluid, InflowSinkTest<Dim, Real>{d_.x.data(), sinks_.data(), sinks_.size()});
     Ops::synchronize();
     r.integration_ms = sw.ms();
     return r;
@@ -192,6 +245,18 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
 
   bool paper() const { return cfg_.model == Model::PaperMultiphase; }
 
+  // Simulation::inflow_mark: the buffer of the emitters active at the step's start (in.emitters_active, the
+  // Simulation's flags); false when none is.
+  bool inflow_mark(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid) {
+    if (in.emitters_active == nullptr) return false;
+    emitter_active_.upload(in.emitters_active, emitters_.size());
+    held_.resize(n_);
+    held_x_.resize(n_);
+    run_pass(fluid, InflowMarkPass<Dim, Real>{d_.x.data(), held_.data(), held_x_.data(), emitters_.data(),
+                                              emitter_active_.data(), emitters_.size()});
+    return true;
+  }
+
   // WCSPH or the paper's model (Simulation::step's sequence): density, wall states, forces, dt, integration.
   void explicit_step(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid,
                      DeviceStepResult<Real>& r, Stopwatch& sw) {
@@ -209,6 +274,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       forces_paper(pv, fluid);
     else
       wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
+    if (body_slot_.size() > 0) body_forces(pv);
     Ops::synchronize();
     r.forces_ms = sw.ms();
 
@@ -250,6 +316,19 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       return;
     }
     paper_forces(cfg_, pv, fluid, tension, wall_states_);
+  }
+
+  // Simulation::compute_body_loads's passes: each body particle's reaction to its fluid neighbours (the
+  // WCSPH pass's own wall term) and its contacts, into body_f_ (summed on the host).
+  void body_forces(const ParticleView<Dim, Real>& pv) {
+    const DeviceRange<Space> all{body_slot_.size()};
+    with_wcsph_forces_pass(cfg_, pv, any_tension_, wall_states_, [&](const auto& pass) {
+      using Pass = std::remove_cvref_t<decltype(pass)>;
+      run_pass(all, BodyReactionPass<Dim, Real, Pass>{pv, pass, body_slot_.data(), body_f_.data()});
+    });
+    auto contact = contact_;
+    contact.pv = pv;
+    run_pass(all, contact);
   }
 
   bool continuity() const { return cfg_.density_evolution == DensityEvolution::Continuity; }
@@ -305,8 +384,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     run_pass(DeviceRange<Space>{ncells}, ClearCellsPass{cell_start_.data()});
     run_pass(all, CellBoundsPass{sorted_key_.data(), n_, cell_start_.data(), cell_end_.data()});
 
-    // Fluid rows (all neighbours) and, for wall states, the wall rows (each wall's fluid neighbours).
-    fill_rows(g, fluid_, false, count_, offsets_, rows_);
+    // Fluid rows (all neighbours; with bodies, their particles' rows too) and, for wall states, the wall
+    // rows (each wall's fluid neighbours).
+    fill_rows(g, row_set_.size() > 0 ? row_set_ : fluid_, false, count_, offsets_, rows_);
     if (wall_states_) fill_rows(g, boundary_, true, wall_count_, wall_start_, wall_rows_);
   }
 
@@ -348,6 +428,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<PhaseParams<Real>> phases_;
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
+  std::vector<std::uint32_t> fluid_host_;
   Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
   Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_grad_;  // DFSPH (models/dfsph.hpp)
   Array<V> f_pressure_, wall_v_, normal_;
@@ -358,6 +439,24 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<std::uint32_t> moving_;
   Array<V> moving_x0_, wall_a_;
   Array<std::int32_t> moving_motion_;
+  // Emitters and sinks (emitters.hpp): the emitters' planes and the sinks (from the config); per emitter
+  // whether it is active this step; per particle its emitter or -1 and its start position (the buffer).
+  Array<EmitterPlane<Dim, Real>> emitters_;
+  Array<Sink> sinks_;
+  Array<std::uint8_t> emitter_active_;
+  Array<std::int32_t> held_;
+  Array<V> held_x_;
+  // Floating bodies (boundary/rigid_bodies.hpp): the rows' owners (fluid and body slots; empty: fluid_);
+  // per body particle its slot, body, offset, force and gathered position; per particle its body; per
+  // body its mass per particle and state; the contact pass with its constants.
+  Array<std::uint32_t> row_set_, body_slot_;
+  Array<std::int32_t> body_of_, body_of_slot_;
+  Array<std::array<double, 3>> body_r0_;
+  Array<double> body_mpp_;
+  Array<RigidBodyState> body_states_;
+  Array<Vec<Dim, double>> body_f_;
+  Array<V> body_x_;
+  BodyContactPass<Dim, Real> contact_{};
   // The grid and the rows.
   Array<std::uint32_t> key_, idx_, sorted_key_, sorted_idx_, cell_start_, cell_end_;
   Array<V> xs_;

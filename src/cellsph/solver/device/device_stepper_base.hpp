@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/particles.hpp"
 
@@ -16,9 +17,10 @@ namespace cellsph {
 
 template <class Real>
 struct DeviceStepResult {
-  Real dt = 0;                  // the step taken
-  std::int64_t first_bad = -1;  // the lowest fluid index failing the stability check, or -1
-  double neighbors_ms = 0;      // wall time of the phases (the device synchronised between them)
+  Real dt = 0;                      // the step taken
+  std::int64_t first_bad = -1;      // the lowest fluid index failing the stability check, or -1
+  std::int64_t first_in_sink = -1;  // sinks: the lowest fluid index inside one at the step's end, or -1
+  double neighbors_ms = 0;          // wall time of the phases (the device synchronised between them)
   double forces_ms = 0;
   double integration_ms = 0;
 };
@@ -37,6 +39,9 @@ struct DeviceStepInput {
   std::uint64_t step = 0;
   Real dfsph_diameter = 0;
   DfsphStats* dfsph = nullptr;
+  // Emitters (emitters.hpp): per emitter 1 when it is active at the step's start (host memory, the
+  // Simulation's); null when none is (no buffer is held).
+  const std::uint8_t* emitters_active = nullptr;
 };
 
 // The device's neighbour rows copied to the host (tests, scripts/gpu_check.sh). Row i of a fluid particle
@@ -66,15 +71,27 @@ class DeviceStepperBase {
   // the device after upload() and back (for checkpoints) with download_solver_state().
   virtual void upload_solver_state(const SolverState<Dim, Real>& s) = 0;
   virtual void download_solver_state(SolverState<Dim, Real>& s) = 0;
-  // Moving walls (boundary/wall_motion.hpp): per moving wall k its slot, initial position and motion (the
-  // Simulation's, after upload()); the motions themselves come with the config.
+  // Moving walls (boundary/wall_motion.hpp): per moving wall k its slot, initial position and motion, and
+  // every particle's wall acceleration at the current time (the Simulation's, after upload()); the motions
+  // themselves come with the config.
   virtual void upload_wall_motion(const std::vector<std::uint32_t>& slot,
                                   const std::vector<Vec<Dim, Real>>& x0,
-                                  const std::vector<std::int32_t>& motion) = 0;
-  // One step of Simulation::step() with a global step: neighbour rows, density, wall states, forces (WCSPH
-  // or the paper's model), dt, integration (symplectic Euler or the paper's leap-frog), box and planes, the
-  // stability check, then the moving walls at the new time. Positions are left as computed even when the
-  // check fails (as on the CPU).
+                                  const std::vector<std::int32_t>& motion,
+                                  const std::vector<Vec<Dim, Real>>& wall_a) = 0;
+  // Floating bodies (boundary/rigid_bodies.hpp), after upload(): their particles' slots, bodies and
+  // offsets, per particle its body, per body its mass per particle, the contact constants. Their particles
+  // get rows like the fluid's (within h: the fluid the reaction reads and the walls a contact reads).
+  virtual void upload_bodies(const RigidBodySystem<Dim, Real>& bodies) = 0;
+  // After step(): per body particle its force of the step (BodyReactionPass after the fluid's forces, plus
+  // BodyContactPass) and its position (the step's start: body particles move only in place_bodies).
+  virtual void download_body_forces(std::vector<Vec<Dim, double>>& f, std::vector<Vec<Dim, Real>>& x) = 0;
+  // The body particles where `states` put them (BodyPlacePass: position, velocity, wall acceleration).
+  virtual void place_bodies(const std::vector<RigidBodyState>& states) = 0;
+  // One step of Simulation::step() with a global step: the emitters' buffer marked, neighbour rows,
+  // density, wall states, forces (WCSPH or the paper's model), dt, integration (symplectic Euler or the
+  // paper's leap-frog), the buffer held, box and planes, the stability check, the moving walls at the new
+  // time, then the sink test. Positions are left as computed even when the check fails (as on the CPU).
+  // Emitting and removing particles is the Simulation's (on the host, then upload() again).
   virtual DeviceStepResult<Real> step(const DeviceStepInput<Real>& in) = 0;
   // The rows of the current positions (built afresh), copied to the host.
   virtual DeviceRows neighbor_rows() = 0;
@@ -86,9 +103,9 @@ std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
   if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
-  if (cfg.inflow.any())
-    return "emitters and sinks (scene keys emitters, sinks) change the particle count, which the device "
-           "step does not (run them with --backend cpu)";
+  if (cfg.rigid_bodies.any() && !(cfg.rigid_bodies.contact_distance < double(cfg.support)))
+    return "floating bodies on a device need body_contact.distance below the support h (the device's rows "
+           "of body particles reach h)";
   return {};
 }
 
