@@ -139,6 +139,16 @@ CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const Vec<Dim, Real>& 
   return grad_w * (-mi * mj * (prho2_i + prho2_j));
 }
 
+// The same force with the number density of Solenthaler & Pajarola 2008 (delta_i = rho_i / m_i, volume
+// 1 / delta_i): f_ij = -(p_i / delta_i^2 + p_j / delta_j^2) grad W_ij = -(m_i^2 k_i + m_j^2 k_j) grad W_ij
+// with k = p / rho^2; f_ji = -f_ij bit for bit (the sum commutes, grad W_ji = -grad W_ij). DFSPH's sweeps
+// with several phases (models/dfsph.hpp); for m_i = m_j it is the force above.
+template <int Dim, class Real>
+CELLSPH_HD inline Vec<Dim, Real> number_density_pressure_force(const Vec<Dim, Real>& grad_w, Real mi, Real mj,
+                                                               Real prho2_i, Real prho2_j) {
+  return grad_w * (-(mi * mi * prho2_i + mj * mj * prho2_j));
+}
+
 template <int Dim, class Real, class Kernel>
 CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, Real>& in, const Kernel& w) {
   return symmetric_pressure_force(w.gradW(in.xij), in.mi, in.mj, in.pi / (in.rhoi * in.rhoi),

@@ -106,8 +106,18 @@ void SolverConfig<Dim, Real>::validate() const {
       if (phases[k].sigma > 0)
         bad("phases[" + std::to_string(k) + "].sigma", phases[k].sigma,
             "the DFSPH model has no surface tension yet (sigma must be 0)");
-    if (density == DensityFormulation::Number)
-      bad("density", "number", "the DFSPH model uses the mass density (density = mass)");
+    // Several rest densities: the mass density of a particle next to another phase is off by up to the
+    // density ratio (docs/physics.md, the two-phase table), and the solver would drive that error to
+    // zero with spurious interface pressures; the number density holds every phase at its own rho0.
+    for (std::size_t k = 1; k < phases.size(); ++k)
+      if (density == DensityFormulation::Mass && phases[k].rest_density != phases[0].rest_density) {
+        std::ostringstream why;
+        why << "the DFSPH model needs the number density (density = number) for phases of different rest "
+               "densities (phases[0].rest_density = "
+            << phases[0].rest_density << ", phases[" << k << "].rest_density = " << phases[k].rest_density
+            << ")";
+        bad("density", "mass", why.str().c_str());
+      }
   }
   if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
   for (std::size_t k = 0; k < wall_motion.motions.size(); ++k) {

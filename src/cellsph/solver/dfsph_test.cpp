@@ -333,7 +333,13 @@ TEST(Dfsph, BadSettingsAreInputErrors) {
   expect_error([](C& c) { c.wall_model = WallModel::Adami; }, "boundary.model = adami");
   expect_error([](C& c) { c.wall_model = WallModel::Dynamic; }, "boundary.model = dynamic");
   expect_error([](C& c) { c.phases[0].sigma = 0.07; }, "phases[0].sigma = 0.07");
-  expect_error([](C& c) { c.density = DensityFormulation::Number; }, "density = number");
+  // Phases of different rest densities need the number density (accepted: dfsph_phases_test.cpp).
+  expect_error(
+      [](C& c) {
+        c.phases.push_back(c.phases[0]);
+        c.phases[1].rest_density = 700;
+      },
+      "density = mass");
   auto ok = dfsph_water<2, double>(0.02, 1.0, 0.01);
   EXPECT_NO_THROW(ok.validate());
 }

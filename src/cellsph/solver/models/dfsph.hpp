@@ -20,6 +20,22 @@
 // compressed. Every pass writes only its own particle's entries; the error averages are reduce_sum
 // (pass_driver.hpp), whose result does not depend on the thread count.
 //
+// Several phases (density = number, Solenthaler & Pajarola 2008): rho_i = m_i delta_i with
+// delta_i = sum_j W_ij + sum_b (V_b / V_i) W_ib, V_i = m_i / rho0_i, V_b = psi_b / rho0_b, i.e.
+// rho_i = sum_j w_ij W_ij with the weight w_ij = m_i for a fluid neighbour and rho0_i V_b for a wall
+// (dfsph_weight; a wall counts as V_b / V_i particles of i's phase, so a wall weighted for water holds oil
+// at oil's rest density). The constraint is rho_i / rho0_i = 1 per particle (errors relative to rho0_i).
+// With G_ij = grad_{x_j} rho_i (G_ii = sum_j w_ij grad W_ij, G_ij = -m_i grad W_ij for fluid j):
+//  * D rho_i / Dt = sum_j w_ij v_ij . grad W_ij (= sum_l G_il . v_l);
+//  * the sweep's force of i's constraint on particle l is -k_i m_i G_il (it sums to 0 over l); with j's
+//    it gives the pair force f_ij = -(m_i^2 k_i + m_j^2 k_j) grad W_ij = -(p_i / delta_i^2 + p_j /
+//    delta_j^2) grad W_ij (number_density_pressure_force, f_ji = -f_ij) and the wall term
+//    -m_i k_i rho0_i V_b grad W_ib, with k = p / rho^2 as in the mass density;
+//  * k_i alone changes D rho_i / Dt by -dt k_i sum_l m_i |G_il|^2 / m_l, so
+//    alpha_i = 1 / (|G_ii|^2 + sum_j m_i^3 / m_j |grad W_ij|^2), the Jacobi diagonal again.
+// For one phase (m_j = m_i, rho0 of the walls = rho0_i) every term is the mass density's; that path keeps
+// its own expressions (number = false), so its bits did not change.
+//
 // The density uses the density kernel, and so do its gradient (the time derivative of that density) and
 // the viscosity's gradient: pressure_kernel is not read by this model.
 #include <algorithm>
@@ -66,15 +82,26 @@ CELLSPH_HD inline Vec<Dim, Real> dfsph_grad(const ParticleView<Dim, Real>& pv, c
   return (xi - pv.x[*it]) * pv.df_grad[it - pv.within];
 }
 
-// D rho_i / Dt = sum_j m_j v_ij . grad W_ij (walls: psi_b, their prescribed velocity), over i's rows, with
-// the step's gradients (df_grad, written by the density pass).
+// The weight a neighbour j carries in i's density rho_i = sum_j w_ij W_ij: m_j for the mass density; for the
+// number density (Solenthaler & Pajarola 2008, rho_i = m_i sum_j W_ij) m_i for a fluid neighbour and
+// rho0_i V_b = rho0_i psi_b / rho0_b for a wall particle (it counts as V_b / V_i particles of i's phase, as
+// in models/summation_density.hpp). The same weight enters the gradient, the rate, alpha and the kick.
 template <int Dim, class Real>
-CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i) {
+CELLSPH_HD inline Real dfsph_weight(const ParticleView<Dim, Real>& pv, bool number, std::size_t i,
+                                    std::uint32_t j) {
+  if (!number) return pv.m[j];
+  return pv.is_fluid(j) ? pv.m[i] : pv.m[j] / pv.rho0[j] * pv.rho0[i];
+}
+
+// D rho_i / Dt = sum_j w_ij v_ij . grad W_ij (walls: their weight, their prescribed velocity), over i's
+// rows, with the step's gradients (df_grad, written by the density pass).
+template <int Dim, class Real>
+CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i, bool number) {
   const Vec<Dim, Real> xi = pv.x[i], vi = pv.v[i];
   Real d = 0;
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
     const std::uint32_t j = *it;
-    d += continuity_term(dfsph_grad(pv, xi, it), pv.m[j], vi - pv.v[j]);
+    d += continuity_term(dfsph_grad(pv, xi, it), dfsph_weight(pv, number, i, j), vi - pv.v[j]);
   }
   return d;
 }
@@ -86,25 +113,29 @@ struct DfsphDensityFactorPass {
   ParticleView<Dim, Real> pv;
   Kernel w;
   Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
+  bool number;       // number density (DensityFormulation::Number)
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
     const Real rho_old = pv.rho[i];
     const Real warm = rho_old > 0 ? pv.p[i] / (rho_old * rho_old) : Real(0);
     const V xi = pv.x[i];
-    Real rho = density_term(w, pv.m[i], Real(0));
+    const Real mi = pv.m[i];
+    Real rho = density_term(w, mi, Real(0));
     V grad{};
     Real sq = 0;
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
-      rho += density_term(w, pv.m[j], norm2(xij));
+      const Real wj = dfsph_weight(pv, number, i, j);
+      rho += density_term(w, wj, norm2(xij));
       const Real gs = w.gradW_factor(xij);
       pv.df_grad[it - pv.within] = gs;  // the step's gradients, read by every sweep (positions fixed)
       const V g = xij * gs;             // = w.gradW(xij), bit for bit
-      const V mg = g * pv.m[j];
+      const V mg = g * wj;
       grad += mg;
-      if (pv.is_fluid(j)) sq += norm2(mg);
+      // |grad_j rho_i|^2 m_i / m_j: m_i = m_j for the mass density of one phase (the 2015 paper's sum).
+      if (pv.is_fluid(j)) sq += number ? norm2(mg) * (mi / pv.m[j]) : norm2(mg);
     }
     const Real denom = norm2(grad) + sq;
     pv.rho[i] = rho;
@@ -127,9 +158,10 @@ struct DfsphSourcePass {
   Real warm_scale;              // 0.5, or 0 without warm starts
   Real* acc;                    // the solve's accumulated k: pv.prho2 (density) or pv.df_kappa_v (divergence)
   std::uint32_t min_neighbors;  // divergence: fewer neighbours, no correction (splashes)
+  bool number;                  // number density (DensityFormulation::Number)
 
   CELLSPH_HD Real operator()(std::size_t i) const {
-    const Real rate = dfsph_density_rate(pv, i);
+    const Real rate = dfsph_density_rate(pv, i, number);
     const Real rho0 = pv.rho0[i];
     Real source = 0;
     if (density) {
@@ -154,6 +186,7 @@ struct DfsphPressureKickPass {
   Kernel w;
   Real dt;
   Real* acc;
+  bool number;  // number density (DensityFormulation::Number)
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -162,8 +195,11 @@ struct DfsphPressureKickPass {
     V f{};
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
-      f += symmetric_pressure_force(dfsph_grad(pv, xi, it), mi, pv.m[j], ki,
-                                    pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
+      if (number && pv.is_fluid(j))
+        f += number_density_pressure_force(dfsph_grad(pv, xi, it), mi, pv.m[j], ki, pv.df_kappa[j]);
+      else
+        f += symmetric_pressure_force(dfsph_grad(pv, xi, it), mi, dfsph_weight(pv, number, i, j), ki,
+                                      pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
     }
     pv.v[i] += f * (dt / mi);
     acc[i] += ki;
@@ -178,6 +214,8 @@ struct DfsphNonPressurePass {
   Vec<Dim, Real> gravity;
   Real eta2;  // the laminar operator's regulariser 0.01 h_s^2 (h_s = support / 2), as in models/wcsph.hpp
   bool no_slip;
+  bool
+      number;  // number density: a wall's volume is its weight rho0_i V_b over rho_i, i.e. V_b rho0_i / rho_i
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -192,7 +230,8 @@ struct DfsphNonPressurePass {
       if (pv.is_fluid(j))
         f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
       else if (no_slip)
-        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
+        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, dfsph_weight(pv, number, i, j) / rhoi,
+                                    mui, mui, eta2);
     }
     pv.f[i] = f;
   }
@@ -226,14 +265,15 @@ struct DfsphSolveResult {
 template <int Dim, class Real, class Kernel, class Set>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
-                             std::uint32_t min_neighbors) {
-  const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc};
+                             std::uint32_t min_neighbors, bool number) {
+  const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number};
   // Half the last step's k, as SPlisHSPlasH: the full sum (measured) set the hydrostatic column and the
   // dam break ringing.
   run_pass(set, DfsphSourcePass<Dim, Real, Kernel>{pv, w, dt, density, true, Real(warm_start ? 0.5 : 0.0),
-                                                   acc, min_neighbors});
+                                                   acc, min_neighbors, number});
   if (warm_start) run_pass(set, kick);
-  const DfsphSourcePass<Dim, Real, Kernel> source{pv, w, dt, density, false, Real(0), acc, min_neighbors};
+  const DfsphSourcePass<Dim, Real, Kernel> source{pv,    w, dt, density, false, Real(0), acc, min_neighbors,
+                                                  number};
   const double n = static_cast<double>(std::max<std::size_t>(set_size(set), 1));
   DfsphSolveResult r;
   for (;;) {
@@ -272,13 +312,14 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
   const auto min_neighbors = static_cast<std::uint32_t>(0.6 * full);
   const double eta_density = double(cfg.dfsph.max_density_error) / 100;
   const double eta_divergence = double(cfg.dfsph.max_divergence_error) / 100;
+  const bool number = cfg.density == DensityFormulation::Number;
 
   Real dt = 0;
   with_kernel<Dim, Real>(cfg.density_kernel, h, [&](const auto w) {
     using K = std::remove_cvref_t<decltype(w)>;
     Stopwatch sw;
     const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
-    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor});
+    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor, number});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
       dt = cfg.time.dt;
@@ -307,21 +348,22 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
         st.last_hit_error = r.error * 100;
       }
     };
-    const DfsphSolveResult div = dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1,
-                                             cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors);
+    const DfsphSolveResult div =
+        dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
+                    cfg.dfsph.warm_start, min_neighbors, number);
     check(div, eta_divergence, "divergence-free");
     st.ms_divergence += sw.ms();
     sw.reset();
 
     run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2),
-                                                       cfg.no_slip});
+                                                       cfg.no_slip, number});
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
     st.ms_nonpressure += sw.ms();
     sw.reset();
 
     const DfsphSolveResult den =
         dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
-                    cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors);
+                    cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors, number);
     check(den, eta_density, "constant-density");
     st.ms_density += sw.ms();
     sw.reset();
