@@ -83,17 +83,23 @@ std::vector<FrontPoint> published_fronts() {
   return ref;
 }
 
-// The surge front (the largest x of a fluid particle plus half a spacing) of a built-in 2D dam break
-// coarsened to spacing s, at the times of `ref`; one thread.
-std::vector<double> simulated_fronts(const std::string& scene_name, const std::string& walls, double s,
-                                     const std::vector<FrontPoint>& ref) {
-  std::string source;
+// A built-in 2D dam break at spacing s (support 2 s) with the given wall model, searched by all-pairs.
+nlohmann::json coarsened(const std::string& scene_name, const std::string& walls, double s,
+                         std::string& source) {
   auto j = read_scene_json(scene_name, source);
   j["spacing"] = s;
   j["solver"]["support"] = 2 * s;
   j["boundary"]["model"] = walls;
   j["neighbors"]["method"] = "all-pairs";
-  const auto scene = load_scene<2, double>(j, source);
+  return j;
+}
+
+// The surge front (the largest x of a fluid particle plus half a spacing) of a built-in 2D dam break
+// coarsened to spacing s, at the times of `ref`; one thread.
+std::vector<double> simulated_fronts(const std::string& scene_name, const std::string& walls, double s,
+                                     const std::vector<FrontPoint>& ref) {
+  std::string source;
+  const auto scene = load_scene<2, double>(coarsened(scene_name, walls, s, source), source);
   ScopedThreads one(1);
   Simulation<2, double> sim(scene.solver, scene.particles);
   std::vector<double> out;
@@ -158,11 +164,7 @@ std::pair<double, int> residual_height(const std::string& walls, const std::stri
                                        double height, double tank_length, double tau_max) {
   const double g = 9.81, a = 1.0;  // the column is a = 1 m wide
   std::string source;
-  auto j = read_scene_json("dam-break-2d", source);
-  j["spacing"] = s;
-  j["solver"]["support"] = 2 * s;
-  j["boundary"]["model"] = walls;
-  j["neighbors"]["method"] = "all-pairs";
+  auto j = coarsened("dam-break-2d", walls, s, source);
   j["fluids"][0]["max"] = {a, height};
   j["boundary"]["walls"]["max"][0] = tank_length;
   j["domain"]["max"][0] = tank_length + 0.5;
