@@ -4,7 +4,8 @@
 # (exit 1) on any crash, hang (an input slower than 10 s), leak, memory blow-up (over 2 GiB) or sanitizer
 # report, printing the input that did it; docs/fuzzing.md says how to replay it.
 #   scripts/fuzz.sh [SECONDS] [NAME...]      e.g. scripts/fuzz.sh 3600 scene   (NAME: scene, points_csv, ...)
-# Environment: FUZZ_RUNS=N also stops a harness after N executions; FUZZ_WORK=DIR keeps the logs, the
+# Environment: FUZZ_RUNS=N also stops a harness after N executions; FUZZ_SEED=S fixes libFuzzer's seed
+# (default: a new one each run; scripts/test.sh fixes it); FUZZ_WORK=DIR keeps the logs, the
 # corpus each run grew and any failing input there (default: a temporary folder, removed when all pass).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -33,6 +34,7 @@ export LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp  # Assimp's own leaks (fuzz
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 RUNS=()
 [ -n "${FUZZ_RUNS:-}" ] && RUNS=(-runs="$FUZZ_RUNS")
+[ -n "${FUZZ_SEED:-}" ] && RUNS+=(-seed="$FUZZ_SEED")
 
 failed=0
 summary=""

@@ -339,6 +339,16 @@ class ParticleBudget {
                       fix_);
   }
 
+  // A lattice site's index along `axis` must fit its integer: fails at `key` if the object reaches `far`
+  // metres from the origin, more than 2^50 spacings.
+  void check_reach(double far, int axis, const JsonReader& r, const std::string& key,
+                   const std::string& what) const {
+    if (!(far / spacing_ < geometry::kMaxLatticeIndex))
+      r.fail(key, what + " reaches " + number(far) + " m from the origin along axis " + std::to_string(axis) +
+                      ", more than 2^50 spacings of " + number(spacing_) + " m: move it closer or use a " +
+                      "coarser spacing");
+  }
+
   // Adds `count` particles made by the object at `key` of `r`; fails there if the total is too many.
   void take(double count, const JsonReader& r, const std::string& key, const std::string& what) {
     planned_ += count;
@@ -681,6 +691,12 @@ void budget_shape(ParticleBudget& budget, const geometry::Shape& s, double spaci
                   double estimate, const JsonReader& r, const std::string& key, const std::string& what) {
   budget.take(estimate, r, key, what);
   budget.take_sites(geometry::lattice_sites(s, spacing, margin), r, key, what);
+  // The lattice is anchored at the origin: a shape so far from it that its site indices pass 2^50 would
+  // overflow them (and has no place in a scene at this spacing anyway).
+  for (int a = 0; a < Dim; ++a) {
+    const auto k = static_cast<std::size_t>(a);
+    budget.check_reach(std::max(std::abs(s.lo()[k] - margin), std::abs(s.hi()[k] + margin)), a, r, key, what);
+  }
 }
 
 template <int Dim, class Real>

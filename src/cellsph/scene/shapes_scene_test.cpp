@@ -293,6 +293,14 @@ TEST(SceneShapes, ErrorsNameTheKeyAndTheFile) {
       {R"({"spacing": 1e-4, "fluids": [{"sphere": {"center": [0,0], "radius": 1000}}]})",
        2,
        {"test.json: /fluids/0: ", "particles"}},
+      // Far from the origin: the lattice's site indices would overflow (a fuzzer's find).
+      {R"({"spacing": 0.1, "fluids": [{"min": [0,0], "max": [1,1]}],
+          "boundary": {"obstacles": [{"sphere": {"center": [-1e107, 0], "radius": 1}}]}})",
+       2,
+       {"test.json: /boundary/obstacles/0: ", "from the origin along axis 0"}},
+      {R"({"spacing": 0.1, "fluids": [{"sphere": {"center": [0, 1e20], "radius": 1}}]})",
+       2,
+       {"test.json: /fluids/0: ", "from the origin along axis 1"}},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.text);
