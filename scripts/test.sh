@@ -29,11 +29,11 @@ cmake --build build/asan -j "$JOBS"
 # release run, 2.5x that here) check physics, which the release run does; the code they run (scenes,
 # solver, probes) is under the sanitizers through the other tests, so they are left out here, as are
 # the three long convergence runs (Stokes' first problem twice, the resting tank: 40 s here) and the
-# 10^4-step still water in a mesh glass, whose
-# code the short wall, motion and diffusion tests run under the sanitizers too.
+# 10^4-step still water in a mesh glass and Archimedes at two spacings, whose
+# code the short wall, motion, diffusion and body tests run under the sanitizers too.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp \
-  ctest --test-dir build/asan -j "$JOBS" --output-on-failure -E '^((Lobovsky2014|SphericTest2|DamBreakResidual)\.|Walls\.NoSlipMatchesStokesFirstProblem|MovingWalls\.SlidingFloorDragsTheFluidAsStokesFirstProblem|DensityDiffusion\.RestingTankPressureAgainstHydrostatic|SceneShapes\.ContainerMeshHoldsStillWaterForTenThousandSteps)'
+  ctest --test-dir build/asan -j "$JOBS" --output-on-failure -E '^((Lobovsky2014|SphericTest2|DamBreakResidual)\.|Walls\.NoSlipMatchesStokesFirstProblem|MovingWalls\.SlidingFloorDragsTheFluidAsStokesFirstProblem|DensityDiffusion\.RestingTankPressureAgainstHydrostatic|SceneShapes\.ContainerMeshHoldsStillWaterForTenThousandSteps|RigidBodies\.ArchimedesHalfSubmergedAtDensity500)'
 
 # One fixed seed (FUZZ_SEED, default 1): the same commit fuzzes the same inputs here and in CI, so a
 # clean run here predicts CI's. Finding new failures is the longer runs' job (docs/fuzzing.md).
