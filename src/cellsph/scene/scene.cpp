@@ -1114,6 +1114,34 @@ void read_domain(JsonReader& r, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regi
   if (!regions.container) regions.container = b;
 }
 
+// A scene without /domain and without a box: the bounding box of its starting particles and emitters,
+// grown on every side by the box's longest side (at least 10 spacings). A particle beyond it has flown
+// off (an explosion, a jet out of an open tank): the run stops and says so, instead of running on with a
+// particle in free flight.
+template <int Dim, class Real>
+void default_domain(const Particles<Dim, Real>& p, const Inflow& inflow, double spacing,
+                    SolverConfig<Dim, Real>& cfg) {
+  if (cfg.domain_set || cfg.box.enabled) return;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  auto grow = [&](int a, double x) {
+    lo[a] = std::min(lo[a], x);
+    hi[a] = std::max(hi[a], x);
+  };
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int a = 0; a < Dim; ++a) grow(a, double(p.x[i][a]));
+  for (const Emitter& e : inflow.emitters)
+    for (int a = 0; a < Dim; ++a) grow(a, e.center[a]);
+  if (!(lo[0] <= hi[0])) return;  // nothing to bound
+  double side = 10 * spacing;
+  for (int a = 0; a < Dim; ++a) side = std::max(side, hi[a] - lo[a]);
+  cfg.domain_set = true;
+  cfg.domain_default = true;
+  for (int a = 0; a < Dim; ++a) {
+    cfg.domain_lo[a] = static_cast<Real>(lo[a] - side);
+    cfg.domain_hi[a] = static_cast<Real>(hi[a] + side);
+  }
+}
+
 // --- fluid blocks (/fluids, /initial_pressure) --------------------------------------------------
 // The particles the fluid blocks ask for, counted from the JSON as it is (before the boundary, as they are
 // most of a scene); a malformed block counts 0 here and is reported by read_fluids.
@@ -1486,6 +1514,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   // Moving obstacles: every particle after the last moving one (fluid, other walls) is at rest.
   if (cfg.wall_motion.any()) cfg.wall_motion.of_particle.resize(s.particles.size(), -1);
   if (cfg.rigid_bodies.any()) cfg.rigid_bodies.of_particle.resize(s.particles.size(), -1);
+  default_domain(s.particles, cfg.inflow, spacing, cfg);
 
   read_output<Dim>(r, s.output);
   read_probes<Dim>(r, s.probes, s.probes_every);

@@ -7,6 +7,7 @@
 
 #include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/simulation.hpp"
 
 namespace cellsph {
 namespace {
@@ -78,6 +79,33 @@ TEST(Scene, BlockIsFilledAtLatticeCentresWithPhaseMass) {
   EXPECT_NEAR(s.solver.phases[0].mass, 1000 * 0.1 * 0.1, 1e-12);  // rest density x spacing^2
   EXPECT_NEAR(s.solver.support, 0.2, 1e-15);                      // default: 2 spacings
   EXPECT_TRUE(s.solver.box.enabled);
+}
+
+// A scene with neither /domain nor a box gets one: its particles' starting bounding box grown by its
+// longest side (here 10 spacings, 1 m, the larger) on every side. Water with nothing under it falls out of
+// it and the run stops, saying so, once the lowest particle is a support below it (y = 0.05 - 1.2 m:
+// after sqrt(2 x 1.2 / 9.81) = 0.49 s of free fall) instead of falling for ever.
+TEST(Scene, WithoutADomainParticlesInFreeFlightStopTheRun) {
+  auto j = nlohmann::json::parse(kMinimal);
+  EXPECT_FALSE((load_scene<2, double>(j, "scene.json").solver.domain_set));  // the box bounds it
+  j.erase("boundary");
+  auto s = load_scene<2, double>(j, "scene.json");
+  ASSERT_TRUE(s.solver.domain_default);
+  EXPECT_DOUBLE_EQ(s.solver.domain_lo[0], 0.05 - 1);
+  EXPECT_DOUBLE_EQ(s.solver.domain_lo[1], 0.05 - 1);
+  EXPECT_DOUBLE_EQ(s.solver.domain_hi[0], 0.95 + 1);
+  EXPECT_DOUBLE_EQ(s.solver.domain_hi[1], 0.45 + 1);
+  Simulation<2, double> sim(s.solver, std::move(s.particles));
+  try {
+    sim.run_until(2);
+    FAIL() << "ran to " << sim.time() << " s";
+  } catch (const SimulationError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("left the domain"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("sets no /domain"), std::string::npos) << msg;
+    EXPECT_GT(sim.time(), 0.4) << msg;
+    EXPECT_LT(sim.time(), 0.6) << msg;
+  }
 }
 
 TEST(Scene, PlanesAreNormalisedAndPassThroughTheirPoint) {

@@ -197,8 +197,10 @@ struct SolverConfig {
   Real friction = Real(0.1);
 
   // Particles outside this box (grown by one support length) stop the run as unstable. If not set, the
-  // box above is used when enabled, otherwise the escape test is off.
+  // box above is used when enabled, otherwise the escape test is off. A scene without /domain or a box
+  // gets a default one (scene/scene.cpp, default_domain; domain_default says so in the diagnosis).
   bool domain_set = false;
+  bool domain_default = false;
   V domain_lo{}, domain_hi{};
 
   // Model::Dfsph (models/dfsph.hpp). Errors in percent, as SPlisHSPlasH takes them: the average density

@@ -570,6 +570,9 @@ void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
     vec(" [lo", lo);
     vec(", hi", hi);
     os << "] (margin " << margin << " m)";
+    if (cfg_.domain_default)
+      os << "; the scene sets no /domain: the default is its starting particles' bounding box grown by its "
+            "longest side on every side (set /domain for another)";
   }
   throw SimulationError(os.str());
 }
