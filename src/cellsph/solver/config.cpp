@@ -165,10 +165,6 @@ void SolverConfig<Dim, Real>::validate() const {
     throw InputError(err);
   if (inflow.any() && time.mode == TimeStepping::PerParticle)
     bad("time.mode", "per-particle", "emitters and sinks need global time steps (fixed or courant)");
-  if (inflow.any() && rigid_bodies.any())
-    bad("emitters", "set",
-        "emitters and sinks cannot run with floating bodies yet (the bodies' tables assume "
-        "a fixed particle count)");
 }
 
 std::string_view model_name(Model m) {

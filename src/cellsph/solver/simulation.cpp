@@ -812,6 +812,7 @@ void Simulation<Dim, Real>::inflow_end_step(Real dt, bool maybe_in_sink) {
   rebuild_kind_lists();
   set_moving_slots();
   move_walls(time_);
+  set_body_slots(true);  // their particles' slots moved; placed again from the same states: the same bits
   if (device_) upload_to_device();  // everything the device holds, at the new count
 }
 
