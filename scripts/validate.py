@@ -69,14 +69,28 @@ SPHERIC = {
 }
 
 
+class Table(dict):
+    """Columns by name; a column the comparison needs and the file lacks stops the script naming both."""
+
+    def __init__(self, path, head):
+        super().__init__((h, []) for h in head)
+        self.path = path
+
+    def __missing__(self, name):
+        sys.exit(f"{self.path}: no column '{name}' (it has: {', '.join(self)}); a run's probes.csv needs the "
+                 "probes of the case's scene: run without --no-run, or with the scene the case names")
+
+
 def read_table(path):
     """A tab- or comma-separated table: '#' lines are comments, the first other line the header."""
     lines = [ln.rstrip("\n") for ln in open(path) if ln.strip() and not ln.startswith("#")]
     if not lines:
         sys.exit(f"{path}: no header and no data")
+    if len(lines) < 2:
+        sys.exit(f"{path}: a header and no data rows")
     sep = "\t" if "\t" in lines[0] else ","
     head = [h.strip() for h in lines[0].split(sep)]
-    cols = {h: [] for h in head}
+    cols = Table(path, head)
     for n, line in enumerate(lines[1:], start=2):
         fields = line.split(sep)
         if len(fields) != len(head):

@@ -27,8 +27,12 @@ def cubic_w(r, h):
 
 
 def frame_at(run, t):
+    if not (run / "frames.csv").exists():
+        sys.exit(f"{run / 'frames.csv'}: not found (RUN must be the output folder of a cellsph run)")
     with open(run / "frames.csv") as f:
         rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"{run / 'frames.csv'}: no frames")
     best = min(rows, key=lambda r: abs(float(r["time"]) - t))
     name = best.get("csv") or next(v for k, v in best.items() if v.endswith(".csv"))
     return float(best["time"]), run / name
@@ -51,6 +55,10 @@ def main():
     keys = rows[0].keys()
     kx = "x" if "x" in keys else "position_x"
     ky = "y" if "y" in keys else "position_y"
+    for k in (kx, ky, "mass", "density"):
+        if k not in keys:
+            sys.exit(f"{path}: no column '{k}' (it has: {', '.join(keys)}); write the frames with "
+                     "--format csv and every field")
     fluid = [r for r in rows if int(float(r.get("kind", 0))) == 0]
     x = np.array([float(r[kx]) for r in fluid])
     y = np.array([float(r[ky]) for r in fluid])

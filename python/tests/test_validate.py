@@ -81,3 +81,21 @@ def test_lobovsky_gate_compares_and_draws_a_second_run(repo_root, tmp_path):
     r = subprocess.run([sys.executable, script, "martin-moyce-a", "--no-run", "--out", str(tmp_path / "gate"),
                         "--compare", str(tmp_path / "instant")], capture_output=True, text=True)
     assert r.returncode != 0 and "--compare" in r.stderr
+
+
+def test_a_run_without_a_needed_column_or_rows_is_refused_by_name(repo_root, tmp_path):
+    # A probes.csv from another scene (no gauge h_x1363) or with a header only: exit 1 with one line
+    # naming the file and the column, not a Python traceback.
+    script = os.path.join(repo_root, "scripts", "validate.py")
+    rows = ["time,h_x0300,h_x0865,h_x1114"] + [f"{0.005 * k},0.3,0,0" for k in range(211)]
+    (tmp_path / "probes.csv").write_text("\n".join(rows) + "\n")
+    r = subprocess.run([sys.executable, script, "lobovsky", "--no-run", "--out", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1, r.stderr
+    assert "Traceback" not in r.stderr
+    assert "probes.csv: no column 'h_x1363'" in r.stderr, r.stderr
+    (tmp_path / "probes.csv").write_text(rows[0] + ",h_x1363\n")
+    r = subprocess.run([sys.executable, script, "lobovsky", "--no-run", "--out", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert "probes.csv: a header and no data rows" in r.stderr, r.stderr
