@@ -46,7 +46,7 @@ struct BenchArgs {
   std::string sizes = "10000,100000,1000000";
   std::string methods;
   std::string radii = "2,4";
-  std::string sets = "lattice,uniform,clustered";
+  std::string sets = "lattice,uniform,uniform-cells,clustered";
   int threads = 0;
   bool threads_given = false;
   int subdivision = 1;
@@ -248,6 +248,9 @@ void bench_neighbors(const BenchArgs& a, const std::vector<Method>& methods,
         // At the lattice's density: n as requested, box side n^(1/Dim) s.
         x = point_sets::uniform_random<Dim, double>(n, s);
         what = "uniform random, lattice density";
+      } else if (set == "uniform-cells") {
+        x = point_sets::uniform_in_cell_order<Dim, double>(n, s);
+        what = "uniform random in cell order (cells of 2 s)";
       } else {
         x = point_sets::clustered<Dim, double>(n, s);
         what = "clustered (8 Gaussian blobs)";
@@ -279,8 +282,9 @@ void run_bench_neighbors(const BenchArgs& a) {
   const auto radii = parse_list<double>("--radii", a.radii, std::numeric_limits<double>::min());
   const auto sets = split(a.sets);
   for (const auto& set : sets)
-    if (set != "lattice" && set != "uniform" && set != "clustered")
-      throw InputError("--sets: unknown point set '" + set + "' (expected lattice,uniform,clustered)");
+    if (set != "lattice" && set != "uniform" && set != "uniform-cells" && set != "clustered")
+      throw InputError("--sets: unknown point set '" + set +
+                       "' (expected a comma-separated list of lattice, uniform, uniform-cells, clustered)");
   if (a.subdivision < 1)
     throw InputError("--subdivision: must be >= 1, got " + std::to_string(a.subdivision));
   if (a.threads_given && a.threads < 1)

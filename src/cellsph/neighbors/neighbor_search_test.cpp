@@ -517,6 +517,35 @@ TEST(SortedGrid, WrapsADenseGridTooLargeForMemory) {
   EXPECT_TRUE(same_lists(brute_force(x, h), nl));
 }
 
+// The benchmark's uniform-cells set: the uniform set's points, reordered so that the cell of side 2 s
+// (last axis slowest) never decreases along the array, and the same neighbour pairs between the same
+// points (every method against all-pairs).
+TEST_P(CrossMethod, UniformInCellOrderIsTheUniformSetSortedByCell) {
+  const auto u = point_sets::uniform_random<3, double>(1500, 1.0);
+  const auto c = point_sets::uniform_in_cell_order<3, double>(1500, 1.0);
+  ASSERT_EQ(u.size(), c.size());
+  auto lex = [](const Vec<3, double>& a, const Vec<3, double>& b) {
+    return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+  };
+  auto su = u, sc = c;
+  std::sort(su.begin(), su.end(), lex);
+  std::sort(sc.begin(), sc.end(), lex);
+  EXPECT_TRUE(std::equal(su.begin(), su.end(), sc.begin(), [&](const auto& a, const auto& b) {
+    return !lex(a, b) && !lex(b, a);
+  })) << "not a permutation of the uniform set";
+  const double side = std::cbrt(1500.0);
+  const auto cells = static_cast<long>(std::ceil(side / 2));
+  long last = -1;
+  for (const auto& p : c) {
+    long k = 0;
+    for (int a = 2; a >= 0; --a) k = k * cells + static_cast<long>(std::floor(p[a] / 2));
+    ASSERT_GE(k, last);
+    last = k;
+  }
+  std::vector<double> h(c.size(), 2.0);
+  expect_exact<3, double>(GetParam(), c, h);
+}
+
 }  // namespace
 }  // namespace cellsph
 

@@ -1,5 +1,6 @@
 #pragma once
 // Point sets shared by tests, benchmarks and `cellsph bench neighbors`. Deterministic for a seed.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -42,6 +43,24 @@ std::vector<Vec<Dim, Real>> uniform_random(std::size_t n, Real s, std::uint64_t 
   std::vector<Vec<Dim, Real>> x(n);
   for (auto& p : x)
     for (int k = 0; k < Dim; ++k) p[k] = static_cast<Real>(u(rng));
+  return x;
+}
+
+// uniform_random's points sorted into cell order: by the cell of side `cell` s each lies in, the last
+// axis slowest (x fastest), as a simulation that reorders its particles holds them. A search that
+// reads candidates by particle index sees them close in memory.
+template <int Dim, class Real>
+std::vector<Vec<Dim, Real>> uniform_in_cell_order(std::size_t n, Real s, double cell = 2,
+                                                  std::uint64_t seed = 2) {
+  auto x = uniform_random<Dim, Real>(n, s, seed);
+  const double side = std::pow(double(n), 1.0 / Dim) * double(s), w = cell * double(s);
+  const auto cells = static_cast<std::uint64_t>(std::ceil(side / w)) + 1;
+  auto key = [&](const Vec<Dim, Real>& p) {
+    std::uint64_t k = 0;
+    for (int a = Dim - 1; a >= 0; --a) k = k * cells + static_cast<std::uint64_t>(double(p[a]) / w);
+    return k;
+  };
+  std::stable_sort(x.begin(), x.end(), [&](const auto& a, const auto& b) { return key(a) < key(b); });
   return x;
 }
 
