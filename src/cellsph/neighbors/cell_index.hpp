@@ -264,15 +264,7 @@ class CellIndex {
       out.indices.clear();
       return 0;
     }
-    std::uint64_t* counts = out.offsets.data() + 1;
-    const std::uint64_t candidates = traverse<false>([&](std::uint32_t p, const Block& blk) {
-      const Probe pr = probe(p);
-      std::uint64_t c = 0;
-      for (std::uint32_t b = 0; b < blk.n; b += 64)
-        c += popcount64(hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b)));
-      // p itself is among its candidates at distance 0 <= h^2 and was counted once.
-      counts[ids_[p]] = c - 1;
-    });
+    const std::uint64_t candidates = count_rows(out.offsets.data() + 1);
     for (std::size_t i = 0; i < n_; ++i) out.offsets[i + 1] += out.offsets[i];
     const std::uint64_t total = out.offsets[n_];
     if (out.indices.capacity() < total || out.indices.capacity() > total + total / 2) {
@@ -320,6 +312,17 @@ class CellIndex {
     return candidates;
   }
 
+  // The number of ordered pairs (i != j) and nothing else: find_all's first traversal, which counts each
+  // row, without the second one that writes them. What the lists cost beyond it is the fill (benchmarks:
+  // the compute floor of issue 15). `counts` gets one row length per particle.
+  std::uint64_t count_pairs(std::vector<std::uint64_t>& counts) const {
+    counts.assign(n_, 0);
+    if (n_ > 0) count_rows(counts.data());
+    std::uint64_t total = 0;
+    for (const std::uint64_t c : counts) total += c;
+    return total;
+  }
+
   [[nodiscard]] std::size_t memory_bytes() const {
     std::size_t s = cells_.capacity() * sizeof(std::uint64_t) +
                     cell_start_.capacity() * sizeof(std::uint32_t) + hs_.capacity() * sizeof(Real) +
@@ -338,6 +341,19 @@ class CellIndex {
   [[nodiscard]] double cell_size() const { return cell_size_; }
 
  private:
+  // Each particle's neighbour count into counts[i] (one traversal, distance tests only); returns the
+  // candidates tested.
+  std::uint64_t count_rows(std::uint64_t* counts) const {
+    return traverse<false>([&](std::uint32_t p, const Block& blk) {
+      const Probe pr = probe(p);
+      std::uint64_t c = 0;
+      for (std::uint32_t b = 0; b < blk.n; b += 64)
+        c += popcount64(hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b)));
+      // p itself is among its candidates at distance 0 <= h^2 and was counted once.
+      counts[ids_[p]] = c - 1;
+    });
+  }
+
   // Particles [begin, end) in key order that lie in one mask cell (or several adjacent ones).
   struct Range {
     std::uint32_t begin, end;

@@ -60,6 +60,24 @@ BENCHMARK(BM_CellIndexBuildAndLists)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
 
+// The count-only scan of the same structure (find_all's first traversal alone: every distance test, one
+// count per particle, no list written), the floor the issue measures the lists against.
+void BM_CellIndexCountOnly(benchmark::State& state) {
+  ScopedThreads threads(2);
+  const auto& x = lattice_1e6();
+  const std::vector<float> h(x.size(), 2.0f);
+  CellIndex<3, float> ci({.method = Method::CellIndex, .subdivision = 1});
+  ci.build(x, h);
+  std::vector<std::uint64_t> counts;
+  std::uint64_t pairs = 0;
+  for (auto _ : state) {
+    pairs = ci.count_pairs(counts);
+    benchmark::DoNotOptimize(counts.data());
+  }
+  state.counters["pairs"] = static_cast<double>(pairs);
+}
+BENCHMARK(BM_CellIndexCountOnly)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+
 // Fresh output lists every iteration: includes the page faults of a first allocation.
 void BM_CellIndexBuildAndFreshLists(benchmark::State& state) {
   ScopedThreads threads(2);

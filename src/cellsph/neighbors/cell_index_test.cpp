@@ -89,6 +89,12 @@ void expect_exact(const Points<Dim, Real>& x, const std::vector<Real>& h, const 
         EXPECT_EQ(a.offsets, ref.offsets);
         EXPECT_EQ(a.indices, ref.indices);
         EXPECT_GE(cand, a.pairs());
+        // The count-only traversal: every row's length, the same pairs in all.
+        std::vector<std::uint64_t> counts;
+        EXPECT_EQ(ci.count_pairs(counts), ref.pairs());
+        ASSERT_EQ(counts.size(), x.size());
+        for (std::size_t i = 0; i < x.size(); ++i)
+          ASSERT_EQ(counts[i], ref.offsets[i + 1] - ref.offsets[i]) << i;
         NeighborList b;
         EXPECT_EQ(build_csr(ci, x.size(), b), cand);
         EXPECT_EQ(b.indices, ref.indices);
