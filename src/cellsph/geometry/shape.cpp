@@ -357,13 +357,17 @@ double lattice_sites(const Shape& s, double spacing, double margin) {
   return n;
 }
 
+double lattice_reach(const Shape& s, double margin, int axis) {
+  const auto k = static_cast<std::size_t>(axis);
+  return std::max(std::abs(s.lo()[k] - margin), std::abs(s.hi()[k] + margin));
+}
+
 std::vector<P3> sample(const Shape& s, double spacing, bool outside, double depth) {
   const double margin = outside ? depth : 0;
   std::array<long, 3> lo{0, 0, 0}, n{1, 1, 1};
   for (int a = 0; a < s.dim(); ++a) {
     const auto k = static_cast<std::size_t>(a);
-    const double far = std::max(std::abs(s.lo()[k] - margin), std::abs(s.hi()[k] + margin)) / spacing;
-    if (!(far < kMaxLatticeIndex))
+    if (!(lattice_reach(s, margin, a) / spacing < kMaxLatticeIndex))
       throw std::invalid_argument("geometry::sample: the shape lies more than 2^50 spacings from the origin");
     lo[k] = static_cast<long>(std::floor((s.lo()[k] - margin) / spacing - 0.5));
     n[k] = static_cast<long>(std::ceil((s.hi()[k] + margin) / spacing - 0.5)) - lo[k] + 1;

@@ -72,7 +72,11 @@ std::vector<P3> sample(const Shape& s, double spacing, bool outside, double dept
 // How many lattice sites sample() looks at (its bounding box of sites), to count before sampling.
 double lattice_sites(const Shape& s, double spacing, double margin);
 
-// The largest |coordinate| / spacing `sample` accepts: its lattice indices are 64-bit integers.
+// How far from the origin [m] the lattice sample() walks along `axis` reaches: the farther of the shape's
+// faces grown by `margin`.
+double lattice_reach(const Shape& s, double margin, int axis);
+
+// The largest lattice_reach / spacing `sample` accepts: its lattice indices are 64-bit integers.
 inline constexpr double kMaxLatticeIndex = 0x1p50;
 
 }  // namespace cellsph::geometry

@@ -693,10 +693,7 @@ void budget_shape(ParticleBudget& budget, const geometry::Shape& s, double spaci
   budget.take_sites(geometry::lattice_sites(s, spacing, margin), r, key, what);
   // The lattice is anchored at the origin: a shape so far from it that its site indices pass 2^50 would
   // overflow them (and has no place in a scene at this spacing anyway).
-  for (int a = 0; a < Dim; ++a) {
-    const auto k = static_cast<std::size_t>(a);
-    budget.check_reach(std::max(std::abs(s.lo()[k] - margin), std::abs(s.hi()[k] + margin)), a, r, key, what);
-  }
+  for (int a = 0; a < Dim; ++a) budget.check_reach(geometry::lattice_reach(s, margin, a), a, r, key, what);
 }
 
 template <int Dim, class Real>
