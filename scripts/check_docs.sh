@@ -6,7 +6,8 @@
 # They run in a scratch folder that links the repo's scenes/, scripts/ and the given build, after a small
 # points.csv is made for the `neighbors` examples.
 # Long runs are shortened by SHORTEN (appended to `run` commands that have no --until/--steps),
-# and `bench neighbors` or `bench sph` without --quick gets --quick, since CI has 2 cores.
+# `bench neighbors` or `bench sph` without --quick gets --quick, and cellsph_bench one short run of each
+# benchmark, since CI has 2 cores.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$(cd "${1:?build dir}" && pwd)"
@@ -30,6 +31,8 @@ while IFS= read -r line; do
   esac
   case "$cmd" in
     *"bench neighbors"*|*"bench sph"*) case "$cmd" in *--quick*) ;; *) cmd="$cmd --quick" ;; esac ;;
+    # Google Benchmark: one short run of each benchmark (the later flags win), to check the filter and the code.
+    build/release/cellsph_bench*|build/cellsph_bench*) cmd="$cmd --benchmark_min_time=0.01 --benchmark_repetitions=1" ;;
   esac
   # Tour runs are long at full length; keep their options but cap the simulated time.
   cmd="$(echo "$cmd" | sed -E 's/--until ([0-9.]+)/--until 0.02/')"

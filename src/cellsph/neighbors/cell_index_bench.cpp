@@ -24,10 +24,25 @@ const std::vector<Vec<3, float>>& lattice_1e6() {
   return x;
 }
 
-// Build + find_all, as `cellsph neighbors` runs it. Arg: subdivision H.
+// The other two sets, r = 2 spacings: uniform random points (in random order) and the same
+// kind of points sorted into cell order.
+const std::vector<Vec<3, float>>& uniform_1e6() {
+  static const auto x = point_sets::uniform_random<3, float>(1000000, 1.0f);
+  return x;
+}
+const std::vector<Vec<3, float>>& uniform_cells_1e6() {
+  static const auto x = point_sets::uniform_in_cell_order<3, float>(1000000, 1.0f);
+  return x;
+}
+const std::vector<Vec<3, float>>& point_set(std::int64_t set) {
+  return set == 0 ? lattice_1e6() : set == 1 ? uniform_1e6() : uniform_cells_1e6();
+}
+
+// Build + find_all, as `cellsph neighbors` runs it, on warm lists (reused across iterations).
+// Args: subdivision H; set (0 lattice, 1 uniform, 2 uniform in cell order).
 void BM_CellIndexBuildAndLists(benchmark::State& state) {
   ScopedThreads threads(2);
-  const auto& x = lattice_1e6();
+  const auto& x = point_set(state.range(1));
   const std::vector<float> h(x.size(), 2.0f);
   CellIndex<3, float> ci({.method = Method::CellIndex, .subdivision = static_cast<int>(state.range(0))});
   NeighborList nl;
@@ -53,9 +68,12 @@ void BM_CellIndexBuildAndLists(benchmark::State& state) {
   state.counters["lists_MB"] = static_cast<double>(nl.memory_bytes()) / 1e6;
 }
 BENCHMARK(BM_CellIndexBuildAndLists)
-    ->Arg(1)
-    ->Arg(2)
-    ->Arg(3)
+    ->ArgNames({"H", "set"})
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->Args({3, 0})
+    ->Args({1, 1})
+    ->Args({1, 2})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
