@@ -25,11 +25,16 @@ std::string nanoflann_version() {
 }
 
 int doctor() {
-  std::printf("cellsph 0.1.0, %s build\n",
+  std::printf("cellsph 0.1.0, %s build%s\n",
 #ifdef NDEBUG
-              "optimised"
+              "optimised",
 #else
-              "debug"
+              "debug",
+#endif
+#ifdef CELLSPH_NATIVE_BUILD
+              " for this machine's CPU (CELLSPH_NATIVE: -march=native)"
+#else
+              " for any x86-64 CPU (AVX2 chosen at run time)"
 #endif
   );
   if (cuda_built())
