@@ -59,6 +59,9 @@ struct ParticleView {
   Real* df_kappa_v = nullptr;     // DFSPH: the divergence solve's pressure / rho^2 (warm start)
   Real* df_grad = nullptr;        // DFSPH: W'(r)/r of each pair of the rows (grad W = x_ij times it), at the
                                   // pair's slot in `within`
+  V* df_gsum = nullptr;           // DFSPH: sum_j w_ij grad W_ij of the step (the density pass)
+  V* df_mv = nullptr;             // DFSPH: w_j v_j (the mass density's sweeps gather it)
+  Real* df_mk = nullptr;          // DFSPH: m_j k_j of the sweep, 0 for a wall
 
   // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +
   // 1]. The rows cut to h (filter_rows): within + offsets[i], within_count[i] long; the pair passes read

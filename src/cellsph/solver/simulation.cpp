@@ -309,6 +309,9 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.df_kappa = df_kappa_.data();
   v.df_kappa_v = state_.dfsph_kappa_v.data();
   v.df_grad = df_grad_.data();
+  v.df_gsum = df_gsum_.data();
+  v.df_mv = df_mv_.data();
+  v.df_mk = df_mk_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
   v.within = within_.data();
@@ -695,8 +698,11 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   df_alpha_.resize(n);
   df_kappa_.resize(n);
   df_grad_.resize(nl_.indices.size());
+  df_gsum_.resize(n);
+  df_mv_.resize(n);
+  df_mk_.resize(n);
   if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
-  const Real dt = dfsph_step(cfg_, view(), fluid_, df_diameter_, dfsph_stats_, steps_ + 1);
+  const Real dt = dfsph_step(cfg_, view(), fluid_, n, df_diameter_, dfsph_stats_, steps_ + 1);
   timings_.forces += sw.ms();
   sw.reset();
   inflow_hold(dt);

@@ -17,8 +17,14 @@
 // v_i by -dt sum_j m_j (k_i + k_j) grad W_ij - dt sum_b psi_b k_i grad W_ib (symmetric_pressure_force with
 // the wall's k = 0: the gradient of i's density constraint, so alpha_i is exactly the Jacobi diagonal).
 // Warm starts (2017 paper): each solve begins with half of the last step's k where the particle is
-// compressed. Every pass writes only its own particle's entries; the error averages are reduce_sum
-// (pass_driver.hpp), whose result does not depend on the thread count.
+// compressed.
+// The sweeps of the mass density (one phase) read two gathered arrays a pair, not four: with the step's
+// G_i = sum_j w_ij grad W_ij (df_gsum, from the density pass), D rho_i / Dt = v_i . G_i - sum_j (w_j v_j) .
+// grad W_ij and the kick -dt (k_i G_i + sum_j (m_j k_j) grad W_ij), with w_j v_j (df_mv) kept by every pass
+// that changes v and m_j k_j (df_mk, 0 for a wall) by the source pass: the same sums regrouped (the pair
+// force's k_i part summed once), so Newton's third law holds to rounding, no longer bit for bit. Every pass
+// writes only its own particle's entries; the error averages are reduce_sum (pass_driver.hpp), whose result
+// does not depend on the thread count.
 //
 // Several phases (density = number, Solenthaler & Pajarola 2008): rho_i = m_i delta_i with
 // delta_i = sum_j W_ij + sum_b (V_b / V_i) W_ib, V_i = m_i / rho0_i, V_b = psi_b / rho0_b, i.e.
@@ -106,6 +112,27 @@ CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std
   return d;
 }
 
+// The same rate regrouped for the mass density (the header): v_i . G_i - sum_j (w_j v_j) . grad W_ij.
+template <int Dim, class Real>
+CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>& pv, std::size_t i) {
+  const Vec<Dim, Real> xi = pv.x[i];
+  Real d = dot(pv.v[i], pv.df_gsum[i]);
+  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
+    d -= dot(pv.df_mv[*it], dfsph_grad(pv, xi, it));
+  return d;
+}
+
+// Before each solve: w_j v_j and m_j k_j = 0 for every particle (the walls keep them through the step; the
+// fluid's are rewritten by the passes that change v and k).
+template <int Dim, class Real>
+struct DfsphPairStatePass {
+  ParticleView<Dim, Real> pv;
+  CELLSPH_HD void operator()(std::size_t i) const {
+    pv.df_mv[i] = pv.v[i] * pv.m[i];
+    pv.df_mk[i] = Real(0);
+  }
+};
+
 // Step 1: density, volume, alpha, and the density solve's warm start k = p / rho^2 of the last step
 // (read before rho is overwritten; p and rho are particle fields, so a checkpoint carries it).
 template <int Dim, class Real, class Kernel>
@@ -141,6 +168,7 @@ struct DfsphDensityFactorPass {
     pv.rho[i] = rho;
     pv.vol[i] = pv.m[i] / rho;
     pv.df_alpha[i] = denom > denom_floor ? Real(1) / denom : Real(0);
+    pv.df_gsum[i] = grad;
     pv.prho2[i] = warm;
   }
 };
@@ -161,7 +189,7 @@ struct DfsphSourcePass {
   bool number;                  // number density (DensityFormulation::Number)
 
   CELLSPH_HD Real operator()(std::size_t i) const {
-    const Real rate = dfsph_density_rate(pv, i, number);
+    const Real rate = number ? dfsph_density_rate(pv, i, number) : dfsph_density_rate_factored(pv, i);
     const Real rho0 = pv.rho0[i];
     Real source = 0;
     if (density) {
@@ -169,12 +197,16 @@ struct DfsphSourcePass {
     } else if (pv.within_count[i] >= min_neighbors) {
       source = std::max(rate, Real(0));
     }
+    Real k;
     if (warm) {
-      pv.df_kappa[i] = source > 0 ? warm_scale * acc[i] : Real(0);
+      k = source > 0 ? warm_scale * acc[i] : Real(0);
       acc[i] = 0;
-      return 0;
+    } else {
+      k = density ? source * pv.df_alpha[i] / (dt * dt) : source * pv.df_alpha[i] / dt;
     }
-    pv.df_kappa[i] = density ? source * pv.df_alpha[i] / (dt * dt) : source * pv.df_alpha[i] / dt;
+    pv.df_kappa[i] = k;
+    pv.df_mk[i] = pv.m[i] * k;
+    if (warm) return 0;
     return density ? source / rho0 : source * dt / rho0;
   }
 };
@@ -192,6 +224,15 @@ struct DfsphPressureKickPass {
     using V = Vec<Dim, Real>;
     const Real mi = pv.m[i], ki = pv.df_kappa[i];
     const V xi = pv.x[i];
+    acc[i] += ki;
+    if (!number) {  // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
+      V s = pv.df_gsum[i] * ki;
+      for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
+        s += dfsph_grad(pv, xi, it) * pv.df_mk[*it];
+      pv.v[i] -= s * dt;
+      pv.df_mv[i] = pv.v[i] * mi;
+      return;
+    }
     V f{};
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
@@ -202,7 +243,7 @@ struct DfsphPressureKickPass {
                                       pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
     }
     pv.v[i] += f * (dt / mi);
-    acc[i] += ki;
+    pv.df_mv[i] = pv.v[i] * mi;
   }
 };
 
@@ -241,7 +282,10 @@ template <int Dim, class Real>
 struct DfsphKickPass {
   ParticleView<Dim, Real> pv;
   Real dt;
-  CELLSPH_HD void operator()(std::size_t i) const { pv.v[i] += pv.f[i] * (dt / pv.m[i]); }
+  CELLSPH_HD void operator()(std::size_t i) const {
+    pv.v[i] += pv.f[i] * (dt / pv.m[i]);
+    pv.df_mv[i] = pv.v[i] * pv.m[i];
+  }
 };
 
 // Step 6.
@@ -294,11 +338,12 @@ Real dfsph_particle_diameter(const ParticleView<Dim, Real>& pv, const IndexSet& 
 }
 
 // One DFSPH step of the particles of `fluid` (rows filtered to h, pv's DFSPH arrays sized for every
-// particle). Returns dt. Throws SimulationError when a solve's error is not finite. `step` is the number of
-// the step being taken (1-based), for messages.
-template <int Dim, class Real, class Set>
+// particle). `all` ranges over every particle, walls too (their df_mv and df_mk). Returns dt. Throws
+// SimulationError when a solve's error is not finite. `step` is the number of the step being taken
+// (1-based), for messages.
+template <int Dim, class Real, class Set, class All>
 Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& fluid,
-                Real diameter, DfsphStats& st, std::uint64_t step) {
+                const All& all, Real diameter, DfsphStats& st, std::uint64_t step) {
   const Real h = cfg.support;
   Real rho0_min = std::numeric_limits<Real>::max(), nu_max = 0;
   for (const auto& ph : cfg.phases) {
@@ -320,6 +365,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     Stopwatch sw;
     const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
     run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor, number});
+    run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
       dt = cfg.time.dt;
