@@ -25,6 +25,10 @@ def test_arrival_rms_and_peak_on_known_series(repo_root):
     assert math.isclose(v.rms_error(t, [0.01, 0.11, 0.21, 5.0], ref_t, ref_v, 0.2), 0.01)
     assert v.peak(t, [1, math.nan, 3, 9], 0.25) == (0.2, 3)
     assert v.interp([0, 1, 2], [0, 10, 0], 1.5) == 5
+    # The impulse: a triangle 0 -> 2000 -> 0 Pa over 0.4-0.48 s is 80 Pa s; samples outside [0.38, 0.5] and
+    # a sample without fluid (0) add nothing.
+    ts = [0.30, 0.40, 0.44, 0.48, 0.49, 0.60]
+    assert math.isclose(v.impulse(ts, [9e9, 0, 2000, 0, math.nan, 9e9]), 80.0)
 
 
 def test_spheric_geometry_follows_the_lattice(repo_root):
