@@ -18,7 +18,7 @@
 // the wall's k = 0: the gradient of i's density constraint, so alpha_i is exactly the Jacobi diagonal).
 // Warm starts (2017 paper): each solve begins with half of the last step's k where the particle is
 // compressed.
-// The sweeps of the mass density (one phase) read two gathered arrays a pair, not four: with the step's
+// The sweeps of the mass density (one phase) gather two arrays a pair, not three or four: with the step's
 // G_i = sum_j w_ij grad W_ij (df_gsum, from the density pass), D rho_i / Dt = v_i . G_i - sum_j (w_j v_j) .
 // grad W_ij and the kick -dt (k_i G_i + sum_j (m_j k_j) grad W_ij), with w_j v_j (df_mv) kept by every pass
 // that changes v and m_j k_j (df_mk, 0 for a wall) by the source pass: the same sums regrouped (the pair
@@ -122,8 +122,9 @@ CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>
   return d;
 }
 
-// Before each solve: w_j v_j and m_j k_j = 0 for every particle (the walls keep them through the step; the
-// fluid's are rewritten by the passes that change v and k).
+// Once a step, after the density pass, for every particle: w_j v_j and m_j k_j = 0 (the walls keep them
+// through the step; the fluid's are rewritten by the passes that change v and k). The mass density's sweeps
+// read them; the number density's do not, so its step skips this pass.
 template <int Dim, class Real>
 struct DfsphPairStatePass {
   ParticleView<Dim, Real> pv;
@@ -365,7 +366,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     Stopwatch sw;
     const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
     run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor, number});
-    run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
+    if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
       dt = cfg.time.dt;
