@@ -9,9 +9,11 @@ PKGS=(g++ cmake ninja-build git pkg-config
 # With --test: what the tests use to check outputs with other people's tools (ffmpeg for the MP4,
 # VTK's own .vtu reader through Debian's python3-vtk9), the Python module's tests (SciPy's cKDTree as
 # the reference search, pytest, matplotlib for the plot of docs/python.md's tour), and clang with
-# libFuzzer and its OpenMP for the fuzz harnesses (scripts/fuzz.sh).
+# libFuzzer and its OpenMP for the fuzz harnesses (scripts/fuzz.sh), and ccache, through which
+# scripts/test.sh compiles, so that a rerun on the same machine recompiles only what changed.
 if [ "${1:-}" = "--test" ]; then
-  PKGS+=(ffmpeg python3-vtk9 python3-scipy python3-pytest python3-matplotlib clang libclang-rt-14-dev libomp-dev)
+  PKGS+=(ffmpeg python3-vtk9 python3-scipy python3-pytest python3-matplotlib clang libclang-rt-14-dev libomp-dev
+         ccache)
 fi
 missing=()
 for p in "${PKGS[@]}"; do

@@ -270,6 +270,28 @@ TEST(CellIndex, DenseCellsGiveAscendingRowsFromAnIndexSortedBlock) {
   }
 }
 
+// One index and one output list reused over builds of other sizes, sets and supports (the sort
+// buffers and the lists keep their memory between builds): every build exact.
+TEST(CellIndex, ReusedAcrossBuildsOfOtherSizes) {
+  CellIndex<3, float> ci;
+  NeighborList a;
+  const std::vector<Points<3, float>> sets = {
+      point_sets::uniform_random<3, float>(4000, 1.0f),
+      point_sets::jittered_lattice<3, float>(500, 1.0f, 0.1f), point_sets::clustered<3, float>(6000, 1.0f),
+      point_sets::uniform_random<3, float>(1, 1.0f), point_sets::uniform_in_cell_order<3, float>(3000, 1.0f)};
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    const auto& x = sets[s];
+    std::vector<float> h(x.size(), 2.0f);
+    if (s == 2)
+      for (std::size_t i = 0; i < h.size(); i += 3) h[i] = 1.3f;  // variable support
+    ci.build(x, h);
+    ci.find_all(a);
+    const NeighborList ref = all_pairs<3, float>(x, h);
+    EXPECT_EQ(a.offsets, ref.offsets) << "set " << s;
+    EXPECT_EQ(a.indices, ref.indices) << "set " << s;
+  }
+}
+
 TEST(CellIndex, WidensKeysWhenEq17DoesNotFit) {
   // 2^28 cells per axis in 2D: 58 bits of cell coordinates plus 9 index bits exceed 64, so the
   // packed key cannot hold it; the wide layout must take over and stay exact.
