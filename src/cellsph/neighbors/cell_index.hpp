@@ -263,7 +263,8 @@ class CellIndex {
   }
 
   // Canonical CSR lists (rows ascending) in two traversals, count then fill, so that nothing but
-  // the lists is allocated at list size. Each row is sorted while it is still in cache.
+  // the lists is allocated at list size. Each row is sorted while it is still in cache. Uses the
+  // index's work buffer: not to be called from two threads at once on one index.
   std::uint64_t find_all(NeighborList& out) const {
     // count_rows writes every row length: only the leading 0 needs a value.
     out.offsets.resize(n_ + 1);
@@ -272,7 +273,9 @@ class CellIndex {
       out.indices.clear();
       return 0;
     }
-    const std::uint64_t candidates = count_rows(out.offsets.data() + 1);
+    // The count pass keeps the hit masks of short blocks (kStoreWords words a particle, in the
+    // buffer the sort used), so the fill pass only packs them.
+    const std::uint64_t candidates = count_rows(out.offsets.data() + 1, true);
     for (std::size_t i = 0; i < n_; ++i) out.offsets[i + 1] += out.offsets[i];
     const std::uint64_t total = out.offsets[n_];
     if (out.indices.capacity() < total || out.indices.capacity() > total + total / 2) {
@@ -293,7 +296,20 @@ class CellIndex {
       // row into the next one) and placed by rank; long ones are written in place.
       std::uint32_t buf[kRankSortMax + 8];
       std::uint64_t c = 0;
-      if (len <= kRankSortMax) {
+      if (blk.n <= kStoreMax) {
+        const std::uint64_t* bits = work_.data() + std::size_t{p} * kStoreWords;
+        if (len <= kRankSortMax) {
+          c = pack_hits(bits, blk, buf);
+        } else {
+          // In place, one at a time: an 8-wide store would overrun into the next row.
+          for (std::uint32_t b = 0, w = 0; b < blk.n; b += 64, ++w)
+            for (std::uint64_t m = bits[w]; m != 0; m &= m - 1) {
+              CELLSPH_CHECK(c < len,
+                            "cell-index: fill pass found more neighbours of " << i << " than counted");
+              row[c++] = blk.id[b + static_cast<std::uint32_t>(std::countr_zero(m))];
+            }
+        }
+      } else if (len <= kRankSortMax) {
         c = write_hits(p, blk, buf);
       } else {
         for_each_hit(p, blk, [&](std::uint32_t, std::uint32_t j) {
@@ -315,9 +331,9 @@ class CellIndex {
       }
     };
     if (sorted_rows_)
-      traverse<true, true>(fill);
+      traverse<true, true, true>(fill);
     else
-      traverse<true>(fill);
+      traverse<true, false, true>(fill);
     return candidates;
   }
 
@@ -337,7 +353,7 @@ class CellIndex {
                     cell_start_.capacity() * sizeof(std::uint32_t) + hs_.capacity() * sizeof(Real) +
                     zero_cell_.capacity() + ids_.capacity() * sizeof(std::uint32_t) +
                     deltas_.capacity() * sizeof(std::uint64_t) + mask_.capacity() * sizeof(MaskCell<Dim>) +
-                    (keys_.capacity() + key_scratch_.capacity()) * sizeof(std::uint64_t);
+                    work_.capacity() * sizeof(std::uint64_t);
     for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
     return s;
   }
@@ -353,15 +369,27 @@ class CellIndex {
  private:
   // Each particle's neighbour count into counts[i] (one traversal, distance tests only); returns the
   // candidates tested.
-  std::uint64_t count_rows(std::uint64_t* counts) const {
+  // With store, the hit masks (p itself left out) of every block of at most kStoreMax candidates are
+  // kept in work_ for the fill pass, which then tests no distance again there.
+  std::uint64_t count_rows(std::uint64_t* counts, bool store = false) const {
+    std::uint64_t* keep = store ? work_.data() : nullptr;
     return traverse<false>([&](std::uint32_t p, const Block& blk) {
       const Probe pr = probe(p);
       std::uint64_t c = 0;
-      for (std::uint32_t b = 0; b < blk.n; b += 64)
-        c += popcount64(hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b)));
-      // p itself is among its candidates at distance 0 <= h^2 and was counted once.
+      if (keep != nullptr && blk.n <= kStoreMax) {
+        std::uint64_t* w = keep + std::size_t{p} * kStoreWords;
+        for (std::uint32_t b = 0; b < blk.n; b += 64) {
+          const std::uint64_t bits = hits_but_self(p, blk, pr, b);
+          *w++ = bits;
+          c += popcount64(bits);
+        }
+      } else {
+        for (std::uint32_t b = 0; b < blk.n; b += 64)
+          c += popcount64(hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b)));
+        --c;  // p itself is among its candidates at distance 0 <= h^2 and was counted once
+      }
       if (p + kAhead < n_) __builtin_prefetch(counts + ids_[p + kAhead], 1);
-      counts[ids_[p]] = c - 1;
+      counts[ids_[p]] = c;
     });
   }
 
@@ -458,28 +486,31 @@ class CellIndex {
   // cells with their first particle.
   void sort_particles(std::span<const Point> x, int pad) {
     const std::size_t n = n_;
-    // The key buffers are kept from one build to the next (a solver rebuilds every step or few):
-    // fresh ones cost a page fault per 4 KiB and a zero fill each time, ~15% of a build at 10^6.
-    std::vector<std::uint64_t>& keys = keys_;
-    std::vector<std::uint64_t>& scratch = key_scratch_;
-    keys.resize(n);
+    // work_ holds the keys and the sort's second buffer here, and find_all's kept hit masks later.
+    // It is kept from one build to the next (a solver rebuilds every step or few): fresh buffers
+    // cost a page fault per 4 KiB and a zero fill each time, 45 ms of a 60 ms build at 10^6 here.
+    work_.resize(std::max(work_.size(), kStoreWords * n));
+    std::uint64_t* keys = work_.data();
+    std::vector<std::uint64_t> wide_keys, scratch;  // the wide path only
     ids_.resize(n);
     if (!wide_) {
       const int I = index_bits_;
       parallel_for(n, [&](std::size_t i) { keys[i] = (cell_key(x[i], pad) << I) | i; });
       // The index bits are already in order (keys are made in index order) and LSD passes are
       // stable, so sorting the cell bits alone gives the full eq. 17 order.
-      radix_sort(keys, scratch, I, I + cell_bits_);
+      keys = radix_sort(std::span(work_.data(), n), std::span(work_.data() + n, n), I, I + cell_bits_);
       const std::uint64_t low = (std::uint64_t{1} << I) - 1;
       parallel_for(n, [&](std::size_t p) { ids_[p] = static_cast<std::uint32_t>(keys[p] & low); });
       parallel_for(n, [&](std::size_t p) { keys[p] >>= I; });
     } else {
       std::vector<std::uint32_t> payload_scratch;
+      wide_keys.resize(n);
       parallel_for(n, [&](std::size_t i) {
-        keys[i] = cell_key(x[i], pad);
+        wide_keys[i] = cell_key(x[i], pad);
         ids_[i] = static_cast<std::uint32_t>(i);
       });
-      radix_sort_pairs(keys, ids_, scratch, payload_scratch, 0, cell_bits_);
+      radix_sort_pairs(wide_keys, ids_, scratch, payload_scratch, 0, cell_bits_);
+      keys = wide_keys.data();
     }
     // keys now holds each particle's cell key in sorted order: extract the distinct cells.
     const int max_t = max_threads();
@@ -677,8 +708,9 @@ class CellIndex {
     }
 
     // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
+    // Without positions (with_x false) only the ids are copied: for blocks whose hit masks were kept.
     template <bool WithIds>
-    Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total) {
+    Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total, bool with_x = true) {
       if (id.size() < total + kPad) {
         for (auto& v : x) v.resize(total + kPad, Real(0));
         id.resize(total + kPad, 0);
@@ -688,7 +720,7 @@ class CellIndex {
         const std::uint32_t b = r[s].begin, len = r[s].end - r[s].begin;
         // Whole groups of kPad: fixed-size copies the compiler inlines (ranges are ~10-30 long,
         // too short for a memmove call to pay); the overshoot lands in padding.
-        for (int k = 0; k < Dim; ++k) {
+        for (int k = 0; k < Dim && with_x; ++k) {
           const Real* src = ci.xs_[k].data() + b;
           Real* dst = x[k].data() + o;
           for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(Real));
@@ -759,6 +791,23 @@ class CellIndex {
     return c;
   }
 
+  // Writes the candidates whose bits are set in the stored masks bits[] (one word per 64 of the
+  // block's candidates) to dst in block order; returns how many. dst needs 8 spare entries.
+  std::uint32_t pack_hits(const std::uint64_t* bits, const Block& blk, std::uint32_t* dst) const {
+    std::uint32_t c = 0;
+    for (std::uint32_t b = 0, w = 0; b < blk.n; b += 64, ++w) {
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+      if (avx2_) {
+        c += detail::left_pack_avx2(blk.id + b, bits[w], std::min<std::uint32_t>(64, blk.n - b), dst + c);
+        continue;
+      }
+#endif
+      for (std::uint64_t m = bits[w]; m != 0; m &= m - 1)
+        dst[c++] = blk.id[b + static_cast<std::uint32_t>(std::countr_zero(m))];
+    }
+    return c;
+  }
+
   // Bit t set when distance2(xi, x_{b+t}) <= hi2 for the block's candidates b + t, t < m <= 64.
   // Computed 8 floats (AVX2) or 4 (SSE2) at a time with the same operations in the same order as
   // distance2, so the test is bit-identical to the all-pairs reference. Reads up to kPad entries
@@ -817,7 +866,8 @@ class CellIndex {
   // order) with the candidates its own support needs. Returns the distance tests.
   // ById: blocks of at least kSortBlockMin candidates shared by a whole home cell are sorted by
   // particle index (BlockBuffer::sort_by_id), for rows that must come out ascending.
-  template <bool WithIds, bool ById = false, class Kernel>
+  // Stored: blocks of at most kStoreMax candidates get no positions (their hit masks were kept).
+  template <bool WithIds, bool ById = false, bool Stored = false, class Kernel>
   std::uint64_t traverse(Kernel&& kernel) const {
     const std::size_t nc = cell_count();
     if (nc == 0) return 0;
@@ -844,7 +894,7 @@ class CellIndex {
           const std::uint32_t len = home_only.end - home_only.begin;
           for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
             local_tests += len - 1;
-            Block blk = own_buf.template fill<WithIds>(*this, &home_only, 1, len);
+            Block blk = own_buf.template fill<WithIds>(*this, &home_only, 1, len, !Stored || len > kStoreMax);
             blk.self0 = 0;
             blk.p0 = start[u];
             kernel(p, blk);
@@ -877,7 +927,8 @@ class CellIndex {
           if (uniform_h_ || hs_[p] == hmax_) {
             // Full support: the whole mask, shared by every such particle of the home cell.
             if (!gathered) {
-              home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total);
+              home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total,
+                                                         !Stored || total > kStoreMax);
               home_blk.self0 = block_pos(merged.data(), nm, start[u]);
               home_blk.p0 = start[u];
               if constexpr (ById)
@@ -901,7 +952,7 @@ class CellIndex {
               mt += r.end - r.begin;
             }
             local_tests += mt - 1;
-            Block blk = own_buf.template fill<WithIds>(*this, mine.data(), nk, mt);
+            Block blk = own_buf.template fill<WithIds>(*this, mine.data(), nk, mt, !Stored || mt > kStoreMax);
             blk.self0 = block_pos(mine.data(), nk, start[u]);
             blk.p0 = start[u];
             kernel(p, blk);
@@ -927,6 +978,10 @@ class CellIndex {
   static constexpr std::size_t kPad = 8;
   static constexpr std::uint32_t kRankSortMax = 96;
   static constexpr std::uint32_t kSortBlockMin = 1024;
+  // Hit masks kept between the two passes of find_all: blocks of up to kStoreMax candidates (the
+  // 27 cells of a uniform set hold ~216), kStoreWords words a particle.
+  static constexpr std::uint32_t kStoreWords = 4, kStoreMax = 64 * kStoreWords;
+  static_assert(kStoreMax < kSortBlockMin, "blocks sorted by id must never use kept masks");
 
   int subdivision_ = 1;
   bool sorted_rows_ = true;
@@ -943,14 +998,16 @@ class CellIndex {
   int index_bits_ = 0;
   int cell_bits_ = 0;
   std::vector<MaskCell<Dim>> mask_;
-  std::vector<std::uint64_t> deltas_;              // key offset of each mask cell, mod 2^64
-  std::vector<std::uint64_t> cells_;               // distinct cell keys in order, + UINT64_MAX sentinel
-  std::vector<std::uint32_t> cell_start_;          // first particle (key order) of each cell, + n
-  std::array<std::vector<Real>, Dim> xs_;          // positions in key order, one array per axis
-  std::vector<Real> hs_;                           // support lengths in key order
-  std::vector<std::uint8_t> zero_cell_;            // 1: every particle of the cell has support 0
-  std::vector<std::uint32_t> ids_;                 // key order -> particle index
-  std::vector<std::uint64_t> keys_, key_scratch_;  // sort buffers, kept for the next build
+  std::vector<std::uint64_t> deltas_;      // key offset of each mask cell, mod 2^64
+  std::vector<std::uint64_t> cells_;       // distinct cell keys in order, + UINT64_MAX sentinel
+  std::vector<std::uint32_t> cell_start_;  // first particle (key order) of each cell, + n
+  std::array<std::vector<Real>, Dim> xs_;  // positions in key order, one array per axis
+  std::vector<Real> hs_;                   // support lengths in key order
+  std::vector<std::uint8_t> zero_cell_;    // 1: every particle of the cell has support 0
+  std::vector<std::uint32_t> ids_;         // key order -> particle index
+  // The sort's keys and second buffer in build, find_all's kept hit masks (kStoreWords words a
+  // particle) after: kept from one build to the next.
+  mutable std::vector<std::uint64_t> work_;
 };
 
 }  // namespace cellsph

@@ -270,6 +270,17 @@ TEST(CellIndex, DenseCellsGiveAscendingRowsFromAnIndexSortedBlock) {
   }
 }
 
+// Supports of 3.2 spacings: rows of ~137 neighbours from blocks on both sides of the 256 candidates
+// whose hit masks find_all keeps between its passes (H = 3), so rows longer than the rank sort
+// takes are packed from kept masks, and blocks too long to keep are tested again.
+TEST(CellIndex, LongRowsFromKeptAndRetestedHitMasks) {
+  const auto x = point_sets::jittered_lattice<3, float>(1728, 1.0f, 0.2f);
+  expect_exact<3, float>(x, std::vector<float>(x.size(), 3.2f), "3D float h = 3.2 spacings");
+  std::vector<float> h(x.size(), 3.2f);
+  for (std::size_t i = 0; i < h.size(); i += 4) h[i] = 2.1f;
+  expect_exact<3, float>(x, h, "3D float, every fourth support 2.1 spacings");
+}
+
 // One index and one output list reused over builds of other sizes, sets and supports (the sort
 // buffers and the lists keep their memory between builds): every build exact.
 TEST(CellIndex, ReusedAcrossBuildsOfOtherSizes) {

@@ -117,6 +117,23 @@ void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& sc
   sort_impl<false>(keys, nullptr, scratch, nullptr, begin_bit, end_bit);
 }
 
+std::uint64_t* radix_sort(std::span<std::uint64_t> keys, std::span<std::uint64_t> scratch, int begin_bit,
+                          int end_bit) {
+  const std::size_t n = keys.size();
+  CELLSPH_CHECK(scratch.size() >= n, "radix_sort: scratch of " << scratch.size() << " for " << n << " keys");
+  const PassPlan plan = plan_passes(keys.data(), n, begin_bit, end_bit);
+  std::uint64_t* from = keys.data();
+  std::uint64_t* to = scratch.data();
+  std::vector<std::size_t> hist;
+  for (int p = 0; p < plan.passes; ++p) {
+    const int shift = plan.lo + p * plan.width;
+    const int width = std::min(plan.width, plan.hi - shift);
+    radix_pass<false>(from, nullptr, to, nullptr, n, shift, width, hist);
+    std::swap(from, to);
+  }
+  return from;
+}
+
 void radix_sort_pairs(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& payload,
                       std::vector<std::uint64_t>& key_scratch, std::vector<std::uint32_t>& payload_scratch,
                       int begin_bit, int end_bit) {

@@ -12,6 +12,7 @@
 // same in every key and cannot change the order. Keys that use few bits sort in few passes.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace cellsph {
@@ -24,6 +25,12 @@ inline constexpr int kRadixMaxDigitBits = 11;
 // the second buffer; on return it holds unspecified values. Both vectors may be swapped internally.
 void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch, int begin_bit = 0,
                 int end_bit = 64);
+
+// Same on the caller's buffers, which keep their memory: sorts the keys with scratch (at least as
+// long) as the second buffer and returns the one that holds the sorted keys (keys.data() or
+// scratch.data(), by the number of passes).
+std::uint64_t* radix_sort(std::span<std::uint64_t> keys, std::span<std::uint64_t> scratch, int begin_bit = 0,
+                          int end_bit = 64);
 
 // Same, moving one 32-bit payload with each key (stable: equal keys keep their payload order).
 void radix_sort_pairs(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& payload,
