@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <span>
 #include <sstream>
 #include <type_traits>
@@ -181,6 +182,15 @@ class CellIndex {
 
   void build(std::span<const Point> x, std::span<const Real> h) {
     CELLSPH_CHECK(h.size() == x.size(), "support lengths " << h.size() << " != points " << x.size());
+    build(x, h, Real(0));
+  }
+
+  // One support length for all particles: no array of them is read or kept.
+  void build(std::span<const Point> x, Real radius) { build(x, {}, radius); }
+
+ private:
+  // h empty: every particle's support is radius.
+  void build(std::span<const Point> x, std::span<const Real> h, Real radius) {
     clear();
     n_ = x.size();
     if (n_ == 0) return;
@@ -190,7 +200,7 @@ class CellIndex {
          << std::numeric_limits<std::uint32_t>::max() << ")";
       throw CapacityError(os.str());
     }
-    const Bounds b = bounds(x, h);
+    const Bounds b = bounds(x, h, radius);
     hmax_ = b.hmax;
     uniform_h_ = b.hmin == b.hmax;
     // h' = (max h / H) * inflation (section 4.1); any positive size is exact when all h are 0. The
@@ -251,6 +261,7 @@ class CellIndex {
     gather(x, h);
   }
 
+ public:
   // Calls f(i, j, r2) for every ordered pair with j in N(i); all calls for one i come from one
   // thread, consecutively, j in key order. Returns the number of distance tests.
   template <class F>
@@ -353,7 +364,7 @@ class CellIndex {
                     cell_start_.capacity() * sizeof(std::uint32_t) + hs_.capacity() * sizeof(Real) +
                     zero_cell_.capacity() + ids_.capacity() * sizeof(std::uint32_t) +
                     deltas_.capacity() * sizeof(std::uint64_t) + mask_.capacity() * sizeof(MaskCell<Dim>) +
-                    work_.capacity() * sizeof(std::uint64_t);
+                    work_.size() * sizeof(std::uint64_t);
     for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
     return s;
   }
@@ -412,6 +423,26 @@ class CellIndex {
     }
   }
 
+  // Memory that is never zero filled (every entry is written before it is read), backed by 2 MiB
+  // pages where Linux grants them: fresh 4 KiB pages cost a page fault each (on this project's VM
+  // 32 MB of them took 80 ms, more than the rest of a build at 10^6).
+  class WorkBuffer {
+   public:
+    void reserve(std::size_t n) {
+      if (n <= size_) return;
+      data_.reset();  // never hold the old and the new buffer at once
+      data_.reset(new std::uint64_t[n]);
+      size_ = n;
+      advise_huge_pages(data_.get(), n * sizeof(std::uint64_t));
+    }
+    [[nodiscard]] std::uint64_t* data() const { return data_.get(); }
+    [[nodiscard]] std::size_t size() const { return size_; }
+
+   private:
+    std::unique_ptr<std::uint64_t[]> data_;
+    std::size_t size_ = 0;
+  };
+
   // Particles [begin, end) in key order that lie in one mask cell (or several adjacent ones).
   struct Range {
     std::uint32_t begin, end;
@@ -435,8 +466,9 @@ class CellIndex {
     index_bits_ = cell_bits_ = 0;
   }
 
-  static Bounds bounds(std::span<const Point> x, std::span<const Real> h) {
-    Bounds all{x[0], x[0], h[0], h[0]};
+  static Bounds bounds(std::span<const Point> x, std::span<const Real> h, Real radius) {
+    const Real h0 = h.empty() ? radius : h[0];
+    Bounds all{x[0], x[0], h0, h0};
     bool finite = true;
 #pragma omp parallel
     {
@@ -445,7 +477,7 @@ class CellIndex {
 #pragma omp for schedule(static) nowait
       for (std::int64_t i = 0; i < static_cast<std::int64_t>(x.size()); ++i) {
         const auto& p = x[static_cast<std::size_t>(i)];
-        const Real hi = h[static_cast<std::size_t>(i)];
+        const Real hi = h.empty() ? radius : h[static_cast<std::size_t>(i)];
         for (int k = 0; k < Dim; ++k) {
           ok = ok && std::isfinite(p[k]);
           loc.lo[k] = std::min(loc.lo[k], p[k]);
@@ -489,7 +521,7 @@ class CellIndex {
     // work_ holds the keys and the sort's second buffer here, and find_all's kept hit masks later.
     // It is kept from one build to the next (a solver rebuilds every step or few): fresh buffers
     // cost a page fault per 4 KiB and a zero fill each time, 45 ms of a 60 ms build at 10^6 here.
-    work_.resize(std::max(work_.size(), kStoreWords * n));
+    work_.reserve(kStoreWords * n);
     std::uint64_t* keys = work_.data();
     std::vector<std::uint64_t> wide_keys, scratch;  // the wide path only
     ids_.resize(n);
@@ -554,18 +586,27 @@ class CellIndex {
       v.resize(n_ + kPad);
       std::fill(v.begin() + static_cast<std::ptrdiff_t>(n_), v.end(), Real(0));
     }
-    hs_.resize(n_);
+    // One support for all (the usual case) needs no array: hmax_ is every particle's.
+    if (uniform_h_) {
+      hs_.clear();
+      hs_.shrink_to_fit();
+    } else {
+      hs_.resize(n_);
+    }
     parallel_for(n_, [&](std::size_t p) {
       // Reads in key order from particle order: a miss each unless asked for ahead.
       if (p + kAhead < n_) __builtin_prefetch(&x[ids_[p + kAhead]]);
       const std::uint32_t i = ids_[p];
       for (int k = 0; k < Dim; ++k) xs_[k][p] = x[i][k];
-      hs_[p] = h[i];
+      if (!uniform_h_) hs_[p] = h[i];
     });
     // Cells whose particles all have support 0 (the solver's wall particles, which need no rows).
     const std::size_t nc = cell_count();
+    if (uniform_h_) {
+      zero_cell_.assign(nc, hmax_ == 0 ? 1 : 0);
+      return;
+    }
     zero_cell_.assign(nc, 0);
-    if (uniform_h_ && hmax_ > 0) return;
     parallel_for(nc, [&](std::size_t u) {
       bool zero = true;
       for (std::uint32_t p = cell_start_[u]; p < cell_start_[u + 1]; ++p) zero = zero && hs_[p] == 0;
@@ -663,7 +704,8 @@ class CellIndex {
   Probe probe(std::uint32_t p) const {
     Probe pr{};
     for (int k = 0; k < Dim; ++k) pr.x[k] = xs_[k][p];
-    pr.h2 = hs_[p] * hs_[p];
+    const Real hp = uniform_h_ ? hmax_ : hs_[p];
+    pr.h2 = hp * hp;
     return pr;
   }
 
@@ -1002,12 +1044,12 @@ class CellIndex {
   std::vector<std::uint64_t> cells_;       // distinct cell keys in order, + UINT64_MAX sentinel
   std::vector<std::uint32_t> cell_start_;  // first particle (key order) of each cell, + n
   std::array<std::vector<Real>, Dim> xs_;  // positions in key order, one array per axis
-  std::vector<Real> hs_;                   // support lengths in key order
+  std::vector<Real> hs_;                   // support lengths in key order (empty when all are hmax_)
   std::vector<std::uint8_t> zero_cell_;    // 1: every particle of the cell has support 0
   std::vector<std::uint32_t> ids_;         // key order -> particle index
   // The sort's keys and second buffer in build, find_all's kept hit masks (kStoreWords words a
   // particle) after: kept from one build to the next.
-  mutable std::vector<std::uint64_t> work_;
+  mutable WorkBuffer work_;
 };
 
 }  // namespace cellsph

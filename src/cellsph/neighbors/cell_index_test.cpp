@@ -281,6 +281,27 @@ TEST(CellIndex, LongRowsFromKeptAndRetestedHitMasks) {
   expect_exact<3, float>(x, h, "3D float, every fourth support 2.1 spacings");
 }
 
+// One support for all, given as a number (no array kept) or as an array: the same lists; a bad
+// number is refused as a bad array is.
+TEST(CellIndex, OneRadiusForAllEqualsAnArrayOfIt) {
+  const auto x = point_sets::uniform_random<3, double>(5000, 1.0);
+  const std::vector<double> h(x.size(), 2.3);
+  const NeighborList ref = all_pairs<3, double>(x, h);
+  CellIndex<3, double> ci;
+  ci.build(x, 2.3);
+  NeighborList a;
+  ci.find_all(a);
+  EXPECT_EQ(a.offsets, ref.offsets);
+  EXPECT_EQ(a.indices, ref.indices);
+  NeighborSearch<3, double> ns({.method = Method::CellIndex});
+  ns.build(x, 2.3);
+  NeighborList b;
+  ns.find_all(b);
+  EXPECT_EQ(b.indices, ref.indices);
+  EXPECT_THROW(ci.build(x, -1.0), std::exception);
+  EXPECT_THROW(ci.build(x, std::nan("")), std::exception);
+}
+
 // One index and one output list reused over builds of other sizes, sets and supports (the sort
 // buffers and the lists keep their memory between builds): every build exact.
 TEST(CellIndex, ReusedAcrossBuildsOfOtherSizes) {

@@ -52,7 +52,18 @@ class NeighborSearch {
   }
 
   // Builds with one support length for all particles.
+  // Builds with one support length for all particles. Methods that take it as is (Cell Indexing)
+  // get no per-particle array.
   void build(std::span<const Point> x, Real radius) {
+    if (auto* ci = std::get_if<CellIndex<Dim, Real>>(&impl_)) {
+      uniform_h_ = {};
+      n_ = x.size();
+      Stopwatch sw;
+      ci->build(x, radius);
+      stats_ = {};
+      stats_.build_ms = sw.ms();
+      return;
+    }
     uniform_h_.assign(x.size(), radius);
     build(x, std::span<const Real>(uniform_h_));
   }
