@@ -18,7 +18,8 @@
 // Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
 // a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
 // (SSE2) at a time and walks the set bits of the hit mask, with no branch per candidate. find_all
-// counts, then fills, and places each short row by rank.
+// counts, keeping the hit masks of blocks of up to 256 candidates, then fills from them (distance
+// tests again only for longer blocks), and places each short row by rank.
 //
 // Exactness: the neighbour test is distance2(x[i], x[j]) <= h[i]^2 in Real, the same expression as
 // the all-pairs reference; the mask only decides which candidates reach that test, and it is built
