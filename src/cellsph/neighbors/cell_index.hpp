@@ -267,7 +267,7 @@ class CellIndex {
   // thread, consecutively, j in key order. Returns the number of distance tests.
   template <class F>
   std::uint64_t for_each_pair(F&& f) const {
-    return traverse<true>([&](std::uint32_t p, const Block& blk) {
+    return traverse<true>([&](std::uint32_t p, const Block& blk, const std::uint64_t*) {
       const std::uint32_t i = ids_[p];
       const Probe pr = probe(p);
       for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) { f(i, j, block_dist2(blk, pr.x, t)); });
@@ -285,8 +285,8 @@ class CellIndex {
       out.indices.clear();
       return 0;
     }
-    // The count pass keeps the hit masks of short blocks (kStoreWords words a particle, in the
-    // buffer the sort used), so the fill pass only packs them.
+    // The count pass keeps every particle's hit masks (see traverse), so the fill pass tests no
+    // distance again: it only packs them.
     const std::uint64_t candidates = count_rows(out.offsets.data() + 1, true);
     for (std::size_t i = 0; i < n_; ++i) out.offsets[i + 1] += out.offsets[i];
     const std::uint64_t total = out.offsets[n_];
@@ -299,42 +299,23 @@ class CellIndex {
     out.indices.resize(total);
     std::uint32_t* idx = out.indices.data();
     const std::uint64_t* off = out.offsets.data();
-    auto fill = [&](std::uint32_t p, const Block& blk) {
+    auto fill = [&](std::uint32_t p, const Block& blk, const std::uint64_t* kept) {
       prefetch_rows(p, off, idx);
       const std::uint32_t i = ids_[p];
       std::uint32_t* row = idx + off[i];
       const std::uint64_t len = off[i + 1] - off[i];
-      // Typical rows are gathered in a small buffer (written 8 at a time, which would overrun the
-      // row into the next one) and placed by rank; long ones are written in place.
-      std::uint32_t buf[kRankSortMax + 8];
-      std::uint64_t c = 0;
-      if (blk.n <= kStoreMax) {
-        const std::uint64_t* bits = work_.data() + std::size_t{p} * kStoreWords;
-        if (len <= kRankSortMax) {
-          c = pack_hits(bits, blk, buf);
-        } else {
-          // In place, one at a time: an 8-wide store would overrun into the next row.
-          for (std::uint32_t b = 0, w = 0; b < blk.n; b += 64, ++w)
-            for (std::uint64_t m = bits[w]; m != 0; m &= m - 1) {
-              CELLSPH_CHECK(c < len,
-                            "cell-index: fill pass found more neighbours of " << i << " than counted");
-              row[c++] = blk.id[b + static_cast<std::uint32_t>(std::countr_zero(m))];
-            }
-        }
-      } else if (len <= kRankSortMax) {
-        c = write_hits(p, blk, buf);
-      } else {
-        for_each_hit(p, blk, [&](std::uint32_t, std::uint32_t j) {
-          CELLSPH_CHECK(c < len, "cell-index: fill pass found more neighbours of " << i << " than counted");
-          row[c++] = j;
-        });
-      }
+      // Rows are gathered in a buffer (written 8 at a time, which would overrun the row into the
+      // next one): typical ones on the stack and placed by rank, long ones in the block's scratch.
+      std::uint32_t small[kRankSortMax + 8];
+      std::uint32_t* buf = len <= kRankSortMax ? small : blk.scratch;
+      const std::uint64_t c = pack_hits(kept, blk, buf);
       CELLSPH_CHECK(c == len,
                     "cell-index: fill pass found " << c << " neighbours of " << i << ", counted " << len);
       // Rows of a block sorted by index come out ascending already.
       const bool sort = sorted_rows_ && !blk.by_id;
       if (len > kRankSortMax) {
-        if (sort) std::sort(row, row + len);
+        if (sort) std::sort(buf, buf + len);
+        std::memcpy(row, buf, len * sizeof(std::uint32_t));
       } else if (sort) {
         rank_sort(buf, static_cast<std::uint32_t>(len), row);
       } else {
@@ -343,9 +324,9 @@ class CellIndex {
       }
     };
     if (sorted_rows_)
-      traverse<true, true, true>(fill);
+      traverse<true, true, Masks::Read>(fill);
     else
-      traverse<true, false, true>(fill);
+      traverse<true, false, Masks::Read>(fill);
     return candidates;
   }
 
@@ -367,6 +348,7 @@ class CellIndex {
                     deltas_.capacity() * sizeof(std::uint64_t) + mask_.capacity() * sizeof(MaskCell<Dim>) +
                     work_.size() * sizeof(std::uint64_t);
     for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
+    for (const auto& v : spill_) s += v.words.capacity() * sizeof(std::uint64_t);
     return s;
   }
 
@@ -380,19 +362,16 @@ class CellIndex {
 
  private:
   // Each particle's neighbour count into counts[i] (one traversal, distance tests only); returns the
-  // candidates tested.
-  // With store, the hit masks (p itself left out) of every block of at most kStoreMax candidates are
-  // kept in work_ for the fill pass, which then tests no distance again there.
+  // candidates tested. With store, every particle's hit masks (p itself left out) are kept for
+  // find_all's fill pass, whose blocks are then in the same order (sorted by id as it sorts them).
   std::uint64_t count_rows(std::uint64_t* counts, bool store = false) const {
-    std::uint64_t* keep = store ? work_.data() : nullptr;
-    return traverse<false>([&](std::uint32_t p, const Block& blk) {
+    auto count = [&](std::uint32_t p, const Block& blk, std::uint64_t* keep) {
       const Probe pr = probe(p);
       std::uint64_t c = 0;
-      if (keep != nullptr && blk.n <= kStoreMax) {
-        std::uint64_t* w = keep + std::size_t{p} * kStoreWords;
+      if (keep != nullptr) {
         for (std::uint32_t b = 0; b < blk.n; b += 64) {
           const std::uint64_t bits = hits_but_self(p, blk, pr, b);
-          *w++ = bits;
+          *keep++ = bits;
           c += popcount64(bits);
         }
       } else {
@@ -402,7 +381,10 @@ class CellIndex {
       }
       if (p + kAhead < n_) __builtin_prefetch(counts + ids_[p + kAhead], 1);
       counts[ids_[p]] = c;
-    });
+    };
+    if (!store) return traverse<false>(count);
+    return sorted_rows_ ? traverse<false, true, Masks::Write>(count)
+                        : traverse<false, false, Masks::Write>(count);
   }
 
   // Rows are written in key order but live in particle order: unless the input is in cell order,
@@ -684,6 +666,7 @@ class CellIndex {
   struct Block {
     const Real* x[Dim];
     const std::uint32_t* id;  // particle indices (only when asked for)
+    std::uint32_t* scratch;   // room for n + kPad entries: the fill pass gathers long rows there
     std::uint32_t n;
     // The home cell's particles are consecutive in the block: key-order particle p sits at
     // candidate self0 + (p - p0), unless the block was sorted by particle index (by_id), which
@@ -722,27 +705,41 @@ class CellIndex {
 
   struct BlockBuffer {
     std::array<std::vector<Real>, Dim> x, x_sorted;
-    std::vector<std::uint32_t> id, self_pos;
-    std::vector<std::uint64_t> order;
+    std::vector<std::uint32_t> id, self_pos, scratch;
+    std::vector<std::uint64_t> order, order2;
 
     // Reorders a filled block by particle index, so that every row found in it is ascending
     // without a sort of its own: one sort per home cell instead of one per particle, which pays
     // in dense cells (hundreds of particles) whose rows are long. `home` particles of the home
-    // cell start at blk.self0.
-    void sort_by_id(Block& blk, std::uint32_t home) {
+    // cell start at blk.self0. An LSD radix sort of the ids, 8 bits a pass over the bits in
+    // which they differ (ids are distinct, so the order is total). Positions move only with_x.
+    void sort_by_id(Block& blk, std::uint32_t home, bool with_x) {
       const std::uint32_t n = blk.n;
+      std::uint32_t lo = id[0], hi = id[0];
+      for (std::uint32_t t = 1; t < n; ++t) {
+        lo = std::min(lo, id[t]);
+        hi = std::max(hi, id[t]);
+      }
       order.resize(n);
-      for (std::uint32_t t = 0; t < n; ++t) order[t] = (std::uint64_t{id[t]} << 32) | t;
-      std::sort(order.begin(), order.end());
+      order2.resize(n);
+      for (std::uint32_t t = 0; t < n; ++t) order[t] = (std::uint64_t{id[t] - lo} << 32) | t;
+      const int bits = static_cast<int>(std::bit_width(hi - lo));
+      for (int shift = 32; shift < 32 + bits; shift += 8) {
+        std::uint32_t count[257] = {};
+        for (std::uint32_t t = 0; t < n; ++t) ++count[((order[t] >> shift) & 0xFFu) + 1];
+        for (int d = 0; d < 256; ++d) count[d + 1] += count[d];
+        for (std::uint32_t t = 0; t < n; ++t) order2[count[(order[t] >> shift) & 0xFFu]++] = order[t];
+        order.swap(order2);
+      }
       self_pos.resize(home);
-      for (int k = 0; k < Dim; ++k) x_sorted[k].resize(x[k].size());
+      for (int k = 0; k < Dim && with_x; ++k) x_sorted[k].resize(x[k].size());
       for (std::uint32_t t = 0; t < n; ++t) {
         const auto from = static_cast<std::uint32_t>(order[t]);
-        for (int k = 0; k < Dim; ++k) x_sorted[k][t] = x[k][from];
-        id[t] = static_cast<std::uint32_t>(order[t] >> 32);
+        for (int k = 0; k < Dim && with_x; ++k) x_sorted[k][t] = x[k][from];
+        id[t] = static_cast<std::uint32_t>(order[t] >> 32) + lo;
         if (from - blk.self0 < home) self_pos[from - blk.self0] = t;
       }
-      for (int k = 0; k < Dim; ++k) {
+      for (int k = 0; k < Dim && with_x; ++k) {
         std::swap(x[k], x_sorted[k]);
         blk.x[k] = x[k].data();
       }
@@ -750,13 +747,28 @@ class CellIndex {
       blk.by_id = true;
     }
 
-    // Copies the particles of ranges r[0, nr) (total of them) into the buffer.
-    // Without positions (with_x false) only the ids are copied: for blocks whose hit masks were kept.
-    template <bool WithIds>
-    Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total, bool with_x = true) {
+    // A block of `total` ids sorted by id, copied from src, without positions.
+    Block ids_from(const std::uint64_t* src, std::uint32_t total) {
+      if (id.size() < total + kPad) {
+        id.resize(total + kPad, 0);
+        scratch.resize(total + kPad);
+      }
+      std::memcpy(id.data(), src, total * sizeof(std::uint32_t));
+      Block blk{};
+      blk.id = id.data();
+      blk.scratch = scratch.data();
+      blk.n = total;
+      blk.by_id = true;
+      return blk;
+    }
+
+    // Copies the particles of ranges r[0, nr) (total of them) into the buffer: their positions
+    // (with_x; a block whose hit masks were kept needs none) and their ids (with_ids).
+    Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total, bool with_x, bool with_ids) {
       if (id.size() < total + kPad) {
         for (auto& v : x) v.resize(total + kPad, Real(0));
         id.resize(total + kPad, 0);
+        scratch.resize(total + kPad);
       }
       std::uint32_t o = 0;
       for (int s = 0; s < nr; ++s) {
@@ -768,12 +780,13 @@ class CellIndex {
           Real* dst = x[k].data() + o;
           for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(Real));
         }
-        if constexpr (WithIds) std::copy_n(ci.ids_.data() + b, len, id.data() + o);
+        if (with_ids) std::copy_n(ci.ids_.data() + b, len, id.data() + o);
         o += len;
       }
       Block blk{};
       for (int k = 0; k < Dim; ++k) blk.x[k] = x[k].data();
       blk.id = id.data();
+      blk.scratch = scratch.data();
       blk.n = total;
       return blk;
     }
@@ -811,27 +824,6 @@ class CellIndex {
         g(t, blk.id[t]);
       }
     }
-  }
-
-  // Writes p's neighbours to dst in block order and returns how many; dst needs 8 spare entries
-  // (the AVX2 path stores 8 at a time).
-  std::uint32_t write_hits(std::uint32_t p, const Block& blk, std::uint32_t* dst) const {
-    const Probe pr = probe(p);
-    std::uint32_t c = 0;
-    for (std::uint32_t b = 0; b < blk.n; b += 64) {
-      std::uint64_t bits = hits_but_self(p, blk, pr, b);
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-      if (avx2_) {
-        c += detail::left_pack_avx2(blk.id + b, bits, std::min<std::uint32_t>(64, blk.n - b), dst + c);
-        continue;
-      }
-#endif
-      while (bits != 0) {
-        dst[c++] = blk.id[b + static_cast<std::uint32_t>(std::countr_zero(bits))];
-        bits &= bits - 1;
-      }
-    }
-    return c;
   }
 
   // Writes the candidates whose bits are set in the stored masks bits[] (one word per 64 of the
@@ -903,24 +895,58 @@ class CellIndex {
     return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
   }
 
+  // Where find_all's count pass keeps the hit masks and its fill pass finds them (traverse).
+  enum class Masks { None, Write, Read };
+
+  // The hit masks of one chunk's particles whose blocks exceed kStoreMax candidates, and the ids of
+  // its blocks sorted by id, in traversal order: the count pass appends them, the fill pass takes
+  // them back in the same order (so it sorts no block again). Grows, never zero filled again.
+  struct Spill {
+    std::vector<std::uint64_t> words;
+    std::size_t at = 0;
+    template <bool Append>
+    std::uint64_t* take(std::size_t w) {
+      if constexpr (Append)
+        if (at + w > words.size()) words.resize(std::max(2 * words.size(), at + w));
+      std::uint64_t* p = words.data() + at;
+      at += w;
+      return p;
+    }
+  };
+
   // The streaming traversal of section 4.2. The sorted cells are split into chunks with
   // boundaries that depend only on the data; each chunk places its cursors by binary search at its
-  // first cell, then moves them forward only. kernel(p, block) is called once per particle p (key
-  // order) with the candidates its own support needs. Returns the distance tests.
+  // first cell, then moves them forward only. kernel(p, block, masks) is called once per particle p
+  // (key order) with the candidates its own support needs. Returns the distance tests.
   // ById: blocks of at least kSortBlockMin candidates shared by a whole home cell are sorted by
   // particle index (BlockBuffer::sort_by_id), for rows that must come out ascending.
-  // Stored: blocks of at most kStoreMax candidates get no positions (their hit masks were kept).
-  template <bool WithIds, bool ById = false, bool Stored = false, class Kernel>
+  // Kept: masks is where p's hit masks go (Write: ceil(n / 64) words) or are (Read); null with None.
+  // Blocks of at most kStoreMax candidates keep them in work_ (kStoreWords words a particle),
+  // longer ones in their chunk's spill. A Read traversal copies no positions.
+  template <bool WithIds, bool ById = false, Masks Kept = Masks::None, class Kernel>
   std::uint64_t traverse(Kernel&& kernel) const {
     const std::size_t nc = cell_count();
     if (nc == 0) return 0;
     const std::size_t M = mask_.size();
     // About 4096 particles per chunk.
     const std::size_t grain = std::max<std::size_t>(1, nc * 4096 / n_);
+    if constexpr (Kept == Masks::Write) spill_.resize((nc + grain - 1) / grain);
     const std::uint64_t* cells = cells_.data();
     const std::uint32_t* start = cell_start_.data();
+    constexpr bool with_x = Kept != Masks::Read;
     std::atomic<std::uint64_t> tests{0};
     parallel_chunks(nc, grain, [&](std::size_t u0, std::size_t u1) {
+      Spill* spill = Kept == Masks::None ? nullptr : &spill_[u0 / grain];
+      if (spill != nullptr) spill->at = 0;
+      // p's masks for a block of n candidates.
+      auto masks = [&](std::uint32_t p, std::uint32_t n) -> std::uint64_t* {
+        if constexpr (Kept == Masks::None) {
+          return nullptr;
+        } else {
+          if (n <= kStoreMax) return work_.data() + std::size_t{p} * kStoreWords;
+          return spill->template take<Kept == Masks::Write>((n + 63) / 64);
+        }
+      };
       std::vector<std::uint32_t> cur(M);
       std::vector<Range> found(M), merged(M), mine(M);
       BlockBuffer home_buf, own_buf;
@@ -937,10 +963,10 @@ class CellIndex {
           const std::uint32_t len = home_only.end - home_only.begin;
           for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
             local_tests += len - 1;
-            Block blk = own_buf.template fill<WithIds>(*this, &home_only, 1, len, !Stored || len > kStoreMax);
+            Block blk = own_buf.fill(*this, &home_only, 1, len, with_x, WithIds);
             blk.self0 = 0;
             blk.p0 = start[u];
-            kernel(p, blk);
+            kernel(p, blk, masks(p, len));
           }
           continue;
         }
@@ -970,16 +996,25 @@ class CellIndex {
           if (uniform_h_ || hs_[p] == hmax_) {
             // Full support: the whole mask, shared by every such particle of the home cell.
             if (!gathered) {
-              home_blk = home_buf.template fill<WithIds>(*this, merged.data(), nm, total,
-                                                         !Stored || total > kStoreMax);
-              home_blk.self0 = block_pos(merged.data(), nm, start[u]);
-              home_blk.p0 = start[u];
-              if constexpr (ById)
-                if (total >= kSortBlockMin) home_buf.sort_by_id(home_blk, start[u + 1] - start[u]);
+              // A block sorted by id needs its ids, whether or not the kernel reads them. The fill
+              // pass takes them back sorted from the count pass's spill.
+              const bool by_id = ById && total >= kSortBlockMin;
+              const std::size_t id_words = (std::size_t{total} + 1) / 2;
+              if (Kept == Masks::Read && by_id) {
+                home_blk = home_buf.ids_from(spill->template take<false>(id_words), total);
+              } else {
+                home_blk = home_buf.fill(*this, merged.data(), nm, total, with_x, WithIds || by_id);
+                home_blk.self0 = block_pos(merged.data(), nm, start[u]);
+                home_blk.p0 = start[u];
+                if (by_id) home_buf.sort_by_id(home_blk, start[u + 1] - start[u], with_x);
+                if (Kept == Masks::Write && by_id)
+                  std::memcpy(spill->template take<true>(id_words), home_blk.id,
+                              total * sizeof(std::uint32_t));
+              }
             }
             gathered = true;
             local_tests += total - 1;
-            kernel(p, home_blk);
+            kernel(p, home_blk, masks(p, total));
           } else {
             // Smaller support: only the mask cells that can reach within h_p (section 4.1).
             const double reach = double(hs_[p]) / cell_size_;
@@ -995,10 +1030,10 @@ class CellIndex {
               mt += r.end - r.begin;
             }
             local_tests += mt - 1;
-            Block blk = own_buf.template fill<WithIds>(*this, mine.data(), nk, mt, !Stored || mt > kStoreMax);
+            Block blk = own_buf.fill(*this, mine.data(), nk, mt, with_x, WithIds);
             blk.self0 = block_pos(mine.data(), nk, start[u]);
             blk.p0 = start[u];
-            kernel(p, blk);
+            kernel(p, blk, masks(p, mt));
           }
         }
       }
@@ -1020,11 +1055,11 @@ class CellIndex {
 
   static constexpr std::size_t kPad = 8;
   static constexpr std::uint32_t kRankSortMax = 96;
-  static constexpr std::uint32_t kSortBlockMin = 1024;
-  // Hit masks kept between the two passes of find_all: blocks of up to kStoreMax candidates (the
-  // 27 cells of a uniform set hold ~216), kStoreWords words a particle.
+  static constexpr std::uint32_t kSortBlockMin = 320;
+  // Hit masks kept between the two passes of find_all in work_: blocks of up to kStoreMax
+  // candidates (the 27 cells of a uniform set hold ~216), kStoreWords words a particle; longer
+  // blocks' masks go to their chunk's spill.
   static constexpr std::uint32_t kStoreWords = 4, kStoreMax = 64 * kStoreWords;
-  static_assert(kStoreMax < kSortBlockMin, "blocks sorted by id must never use kept masks");
 
   int subdivision_ = 1;
   bool sorted_rows_ = true;
@@ -1051,6 +1086,7 @@ class CellIndex {
   // The sort's keys and second buffer in build, find_all's kept hit masks (kStoreWords words a
   // particle) after: kept from one build to the next.
   mutable WorkBuffer work_;
+  mutable std::vector<Spill> spill_;  // one per traversal chunk: the masks of blocks over kStoreMax
 };
 
 }  // namespace cellsph

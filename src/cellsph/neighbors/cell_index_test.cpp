@@ -252,7 +252,7 @@ TEST(CellIndex, PairsWithinUlpsOfTheSupportMatchAllPairs) {
   EXPECT_EQ(via_visitor(ci, x).indices, ref.indices);
 }
 
-// Cells holding hundreds of particles: their shared candidate blocks (over 1024) are sorted by index
+// Cells holding hundreds of particles: their shared candidate blocks (from 320) are sorted by index
 // once, so that the long rows come out ascending without a sort each; the lists must not change.
 TEST(CellIndex, DenseCellsGiveAscendingRowsFromAnIndexSortedBlock) {
   const auto x = point_sets::uniform_random<3, double>(3000, 0.05);  // a box about 0.7 wide
@@ -271,14 +271,43 @@ TEST(CellIndex, DenseCellsGiveAscendingRowsFromAnIndexSortedBlock) {
 }
 
 // Supports of 3.2 spacings: rows of ~137 neighbours from blocks on both sides of the 256 candidates
-// whose hit masks find_all keeps between its passes (H = 3), so rows longer than the rank sort
-// takes are packed from kept masks, and blocks too long to keep are tested again.
+// whose hit masks find_all keeps in its work buffer (H = 3; longer blocks keep theirs in the spill),
+// so rows longer than the rank sort takes are packed from kept masks of both kinds.
 TEST(CellIndex, LongRowsFromKeptAndRetestedHitMasks) {
   const auto x = point_sets::jittered_lattice<3, float>(1728, 1.0f, 0.2f);
   expect_exact<3, float>(x, std::vector<float>(x.size(), 3.2f), "3D float h = 3.2 spacings");
   std::vector<float> h(x.size(), 3.2f);
   for (std::size_t i = 0; i < h.size(); i += 4) h[i] = 2.1f;
   expect_exact<3, float>(x, h, "3D float, every fourth support 2.1 spacings");
+}
+
+// Blocks over the 256 candidates whose hit masks stay in the work buffer keep theirs in their
+// traversal chunk's spill: from 257 to 319 candidates in block order, from 320 on sorted by id with
+// the sorted ids kept too, which the fill pass takes back instead of sorting again. Two densities
+// side by side (about 270 and 675 candidates a full block at H = 1, about 110 and 280 at H = 2) give
+// both kinds over several chunks (about 4096 particles each), with every fifth support smaller;
+// then one index is reused on a smaller set, over a spill it does not clear.
+TEST(CellIndex, LongBlocksKeepTheirHitMasksInTheSpill) {
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Points<3, float> x;
+  for (int i = 0; i < 6000; ++i) x.push_back({{6.0f * u(rng), 10.0f * u(rng), 10.0f * u(rng)}});
+  for (int i = 0; i < 10000; ++i) x.push_back({{6.0f + 4.0f * u(rng), 10.0f * u(rng), 10.0f * u(rng)}});
+  std::vector<float> h(x.size(), 1.0f);
+  for (std::size_t i = 0; i < h.size(); i += 5) h[i] = 0.7f;
+  expect_exact<3, float>(x, h, "two densities, every fifth support 0.7");
+
+  CellIndex<3, float> ci;
+  NeighborList a;
+  for (std::size_t n : {x.size(), std::size_t{9000}}) {
+    const Points<3, float> xs(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(n));
+    const std::vector<float> hs(n, 1.0f);
+    ci.build(xs, hs);
+    ci.find_all(a);
+    const NeighborList ref = all_pairs<3, float>(xs, hs);
+    EXPECT_EQ(a.offsets, ref.offsets) << n;
+    EXPECT_EQ(a.indices, ref.indices) << n;
+  }
 }
 
 // One support for all, given as a number (no array kept) or as an array: the same lists; a bad
