@@ -181,6 +181,11 @@ class CellIndex {
   // key would fit. For tests and for measuring what the packing saves.
   void force_wide_keys(bool on) { force_wide_ = on; }
 
+  // Caps the blocks sorted by id whose order find_all keeps between its passes (at most 2^16, the
+  // default); longer ones are sorted again by the fill pass. For tests: blocks of 2^16 candidates
+  // cost 2^32 distance tests each against the all-pairs reference.
+  void limit_kept_order(std::uint32_t n) { kept_order_max_ = std::min(n, kKeptOrderMax); }
+
   void build(std::span<const Point> x, std::span<const Real> h) {
     CELLSPH_CHECK(h.size() == x.size(), "support lengths " << h.size() << " != points " << x.size());
     build(x, h, Real(0));
@@ -348,7 +353,7 @@ class CellIndex {
                     deltas_.capacity() * sizeof(std::uint64_t) + mask_.capacity() * sizeof(MaskCell<Dim>) +
                     work_.size() * sizeof(std::uint64_t);
     for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
-    for (const auto& v : spill_) s += v.words.capacity() * sizeof(std::uint64_t);
+    for (const auto& v : spill_) s += v.bytes();
     return s;
   }
 
@@ -747,19 +752,23 @@ class CellIndex {
       blk.by_id = true;
     }
 
-    // A block of `total` ids sorted by id, copied from src, without positions.
-    Block ids_from(const std::uint64_t* src, std::uint32_t total) {
-      if (id.size() < total + kPad) {
-        id.resize(total + kPad, 0);
-        scratch.resize(total + kPad);
+    // After sort_by_id: where each of the block's n candidates came from, 16 bits each (four a
+    // word), to dst.
+    void save_order(std::uint64_t* dst, std::uint32_t n) const {
+      for (std::uint32_t t = 0; t < n; t += 4) {
+        std::uint64_t w = 0;
+        for (std::uint32_t k = 0; k < 4 && t + k < n; ++k) w |= (order[t + k] & 0xFFFFu) << (16 * k);
+        dst[t / 4] = w;
       }
-      std::memcpy(id.data(), src, total * sizeof(std::uint32_t));
-      Block blk{};
+    }
+
+    // Puts a freshly filled block's ids in the order save_order kept (the fill pass: no positions).
+    void permute_ids(Block& blk, const std::uint64_t* src) {
+      for (std::uint32_t t = 0; t < blk.n; ++t) scratch[t] = id[(src[t / 4] >> (16 * (t % 4))) & 0xFFFFu];
+      std::swap(id, scratch);
       blk.id = id.data();
       blk.scratch = scratch.data();
-      blk.n = total;
       blk.by_id = true;
-      return blk;
     }
 
     // Copies the particles of ranges r[0, nr) (total of them) into the buffer: their positions
@@ -898,19 +907,46 @@ class CellIndex {
   // Where find_all's count pass keeps the hit masks and its fill pass finds them (traverse).
   enum class Masks { None, Write, Read };
 
-  // The hit masks of one chunk's particles whose blocks exceed kStoreMax candidates, and the ids of
-  // its blocks sorted by id, in traversal order: the count pass appends them, the fill pass takes
-  // them back in the same order (so it sorts no block again). Grows, never zero filled again.
+  // The hit masks of one chunk's particles whose blocks exceed kStoreMax candidates, and the sort
+  // order of its blocks sorted by id (BlockBuffer::save_order), in traversal order: the count pass
+  // appends them, the fill pass takes them back in the same order (so it sorts no block again, up
+  // to kept_order_max_ candidates; memory for speed: see docs/benchmarks.md). Stored in pages of at least
+  // kSpillPage words, so that at most the tail of each page is unused (a doubling vector would
+  // hold up to twice what it needs); a take that does not fit the rest of a page starts the next
+  // one, enlarged first if the take is larger. The count pass only ever enlarges a page before
+  // its first take, so the fill pass, taking the same sizes in the same order, finds the same
+  // places. Pages are kept from one find_all to the next, never zero filled.
   struct Spill {
-    std::vector<std::uint64_t> words;
-    std::size_t at = 0;
+    struct Page {
+      std::unique_ptr<std::uint64_t[]> words;
+      std::size_t size = 0;
+    };
+    std::vector<Page> pages;
+    std::size_t page = 0, at = 0;
+    void rewind() { page = at = 0; }
     template <bool Append>
     std::uint64_t* take(std::size_t w) {
-      if constexpr (Append)
-        if (at + w > words.size()) words.resize(std::max(2 * words.size(), at + w));
-      std::uint64_t* p = words.data() + at;
+      if (pages.empty() || at + w > pages[page].size) {
+        if (!pages.empty()) ++page;
+        at = 0;
+        if constexpr (Append) {
+          if (page == pages.size()) pages.emplace_back();
+          Page& pg = pages[page];
+          if (pg.size < w) {
+            pg.words.reset();
+            pg.size = std::max(w, kSpillPage);
+            pg.words.reset(new std::uint64_t[pg.size]);
+          }
+        }
+      }
+      std::uint64_t* p = pages[page].words.get() + at;
       at += w;
       return p;
+    }
+    [[nodiscard]] std::size_t bytes() const {
+      std::size_t b = 0;
+      for (const auto& pg : pages) b += pg.size * sizeof(std::uint64_t);
+      return b;
     }
   };
 
@@ -937,7 +973,7 @@ class CellIndex {
     std::atomic<std::uint64_t> tests{0};
     parallel_chunks(nc, grain, [&](std::size_t u0, std::size_t u1) {
       Spill* spill = Kept == Masks::None ? nullptr : &spill_[u0 / grain];
-      if (spill != nullptr) spill->at = 0;
+      if (spill != nullptr) spill->rewind();
       // p's masks for a block of n candidates.
       auto masks = [&](std::uint32_t p, std::uint32_t n) -> std::uint64_t* {
         if constexpr (Kept == Masks::None) {
@@ -997,19 +1033,20 @@ class CellIndex {
             // Full support: the whole mask, shared by every such particle of the home cell.
             if (!gathered) {
               // A block sorted by id needs its ids, whether or not the kernel reads them. The fill
-              // pass takes them back sorted from the count pass's spill.
+              // pass gathers them again and takes back from the count pass's spill where each came
+              // from (16 bits a candidate, so blocks up to 2^16), instead of sorting again.
               const bool by_id = ById && total >= kSortBlockMin;
-              const std::size_t id_words = (std::size_t{total} + 1) / 2;
-              if (Kept == Masks::Read && by_id) {
-                home_blk = home_buf.ids_from(spill->template take<false>(id_words), total);
-              } else {
-                home_blk = home_buf.fill(*this, merged.data(), nm, total, with_x, WithIds || by_id);
-                home_blk.self0 = block_pos(merged.data(), nm, start[u]);
-                home_blk.p0 = start[u];
-                if (by_id) home_buf.sort_by_id(home_blk, start[u + 1] - start[u], with_x);
-                if (Kept == Masks::Write && by_id)
-                  std::memcpy(spill->template take<true>(id_words), home_blk.id,
-                              total * sizeof(std::uint32_t));
+              const bool kept_order = by_id && total <= kept_order_max_;
+              const std::size_t order_words = (std::size_t{total} + 3) / 4;
+              home_blk = home_buf.fill(*this, merged.data(), nm, total, with_x, WithIds || by_id);
+              home_blk.self0 = block_pos(merged.data(), nm, start[u]);
+              home_blk.p0 = start[u];
+              if (Kept == Masks::Read && kept_order) {
+                home_buf.permute_ids(home_blk, spill->template take<false>(order_words));
+              } else if (by_id) {
+                home_buf.sort_by_id(home_blk, start[u + 1] - start[u], with_x);
+                if (Kept == Masks::Write && kept_order)
+                  home_buf.save_order(spill->template take<true>(order_words), total);
               }
             }
             gathered = true;
@@ -1060,11 +1097,14 @@ class CellIndex {
   // candidates (the 27 cells of a uniform set hold ~216), kStoreWords words a particle; longer
   // blocks' masks go to their chunk's spill.
   static constexpr std::uint32_t kStoreWords = 4, kStoreMax = 64 * kStoreWords;
+  static constexpr std::size_t kSpillPage = std::size_t{1} << 11;  // 16 KiB
+  static constexpr std::uint32_t kKeptOrderMax = std::uint32_t{1} << 16;
 
   int subdivision_ = 1;
   bool sorted_rows_ = true;
   bool avx2_ = detail::cpu_has_avx2();
   bool force_wide_ = false;
+  std::uint32_t kept_order_max_ = kKeptOrderMax;
   std::size_t n_ = 0;
   bool wide_ = false;
   bool uniform_h_ = true;

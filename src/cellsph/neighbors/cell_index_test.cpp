@@ -283,7 +283,7 @@ TEST(CellIndex, LongRowsFromKeptAndRetestedHitMasks) {
 
 // Blocks over the 256 candidates whose hit masks stay in the work buffer keep theirs in their
 // traversal chunk's spill: from 257 to 319 candidates in block order, from 320 on sorted by id with
-// the sorted ids kept too, which the fill pass takes back instead of sorting again. Two densities
+// the sort's order kept too, which the fill pass takes back instead of sorting again. Two densities
 // side by side (about 270 and 675 candidates a full block at H = 1, about 110 and 280 at H = 2) give
 // both kinds over several chunks (about 4096 particles each), with every fifth support smaller;
 // then one index is reused on a smaller set, over a spill it does not clear.
@@ -307,6 +307,15 @@ TEST(CellIndex, LongBlocksKeepTheirHitMasksInTheSpill) {
     const NeighborList ref = all_pairs<3, float>(xs, hs);
     EXPECT_EQ(a.offsets, ref.offsets) << n;
     EXPECT_EQ(a.indices, ref.indices) << n;
+    // Blocks sorted by id too long to keep their order (over 2^16 by default; here over 500, of
+    // the dense half's ~675) are sorted again by the fill pass, next to kept ones.
+    CellIndex<3, float> cap;
+    cap.limit_kept_order(500);
+    cap.build(xs, hs);
+    NeighborList b;
+    cap.find_all(b);
+    EXPECT_EQ(b.offsets, ref.offsets) << n;
+    EXPECT_EQ(b.indices, ref.indices) << n;
   }
 }
 
