@@ -133,27 +133,52 @@ __attribute__((target("avx2"))) inline std::uint32_t left_pack_avx2(const std::u
   return c;
 }
 
+// Ranks of the NB * 8 values biased[k0, k0 + 8 NB) among biased[0, L): each biased[m] is broadcast
+// once and compared with all NB registers, whose NB sums are independent (no one chain of L adds).
+template <int NB>
+__attribute__((target("avx2"))) inline void rank_block_avx2(const std::int32_t* biased, std::uint32_t L,
+                                                            std::uint32_t k0, std::uint32_t* rank) {
+  __m256i v[NB], acc[NB];
+  for (int b = 0; b < NB; ++b) {
+    v[b] = _mm256_load_si256(reinterpret_cast<const __m256i*>(biased + k0 + 8 * b));
+    acc[b] = _mm256_setzero_si256();
+  }
+  for (std::uint32_t m = 0; m < L; ++m) {
+    const __m256i w = _mm256_set1_epi32(biased[m]);
+    for (int b = 0; b < NB; ++b) acc[b] = _mm256_sub_epi32(acc[b], _mm256_cmpgt_epi32(v[b], w));
+  }
+  for (int b = 0; b < NB; ++b) _mm256_store_si256(reinterpret_cast<__m256i*>(rank + 8 * b), acc[b]);
+}
+
 // Sorts the distinct in[0, L) (L <= kMax) into out by rank, out[#{m : in[m] < in[k]}] = in[k], eight
-// values of k at a time: each in[m] is broadcast once and compared with eight of them, so the ranks
-// come out in one register, with no horizontal sum. Reads up to 8 entries past in[L - 1].
+// values of k to a register and up to four registers at a time: each in[m] is broadcast once and
+// compared with all of them, so the ranks come out in registers, with no horizontal sum. Reads up to
+// 8 entries past in[L - 1].
 template <std::uint32_t kMax>
 __attribute__((target("avx2"))) inline void rank_sort_avx2(const std::uint32_t* in, std::uint32_t L,
                                                            std::uint32_t* out) {
-  // Unsigned order through the signed compare: flip the top bit of every value once.
-  alignas(32) std::int32_t biased[kMax + 8];
+  // Unsigned order through the signed compare: flip the top bit of every value once. Entries past L
+  // (up to the next 32) are read as a block's padding; their ranks are never used.
+  alignas(32) std::int32_t biased[kMax + 32];
   const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
-  for (std::uint32_t m = 0; m < L; m += 8)
+  std::uint32_t m = 0;
+  for (; m < L; m += 8)
     _mm256_store_si256(reinterpret_cast<__m256i*>(biased + m),
                        _mm256_xor_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + m)), bias));
-  for (std::uint32_t k = 0; k < L; k += 8) {
-    const __m256i v = _mm256_load_si256(reinterpret_cast<const __m256i*>(biased + k));
-    __m256i acc = _mm256_setzero_si256();
-    for (std::uint32_t m = 0; m < L; ++m)
-      acc = _mm256_sub_epi32(acc, _mm256_cmpgt_epi32(v, _mm256_set1_epi32(biased[m])));
-    alignas(32) std::uint32_t rank[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(rank), acc);
-    const std::uint32_t e = std::min<std::uint32_t>(8, L - k);
-    for (std::uint32_t t = 0; t < e; ++t) out[rank[t]] = in[k + t];
+  for (; m < ((L + 31) & ~31u); m += 8) _mm256_store_si256(reinterpret_cast<__m256i*>(biased + m), bias);
+  alignas(32) std::uint32_t rank[32];
+  for (std::uint32_t k0 = 0; k0 < L; k0 += 32) {
+    const std::uint32_t left = L - k0;
+    if (left > 24)
+      rank_block_avx2<4>(biased, L, k0, rank);
+    else if (left > 16)
+      rank_block_avx2<3>(biased, L, k0, rank);
+    else if (left > 8)
+      rank_block_avx2<2>(biased, L, k0, rank);
+    else
+      rank_block_avx2<1>(biased, L, k0, rank);
+    const std::uint32_t e = std::min<std::uint32_t>(32, left);
+    for (std::uint32_t t = 0; t < e; ++t) out[rank[t]] = in[k0 + t];
   }
 }
 #else

@@ -319,6 +319,30 @@ TEST(CellIndex, LongBlocksKeepTheirHitMasksInTheSpill) {
   }
 }
 
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+// The AVX2 rank sort that orders short rows, on every length up to its limit (one to four registers a
+// block, one to three blocks), distinct values on both sides of 2^31 (the signed compare's bias),
+// against std::sort.
+TEST(CellIndex, RankSortOrdersEveryRowLength) {
+  if (!detail::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: the portable sort runs instead";
+  std::mt19937 rng(96);
+  for (std::uint32_t L = 1; L <= 96; ++L)
+    for (int rep = 0; rep < 20; ++rep) {
+      std::vector<std::uint32_t> v;
+      while (v.size() < L) {
+        const auto x = static_cast<std::uint32_t>(rep % 2 ? rng() : rng() % 200);
+        if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+      }
+      std::vector<std::uint32_t> in(v);
+      in.resize(L + 8, 0xFFFFFFFFu);  // the 8 entries past L it may read
+      std::vector<std::uint32_t> out(L, 0);
+      detail::rank_sort_avx2<96>(in.data(), L, out.data());
+      std::sort(v.begin(), v.end());
+      ASSERT_EQ(out, v) << "L = " << L << ", rep " << rep;
+    }
+}
+#endif
+
 // One support for all, given as a number (no array kept) or as an array: the same lists; a bad
 // number is refused as a bad array is.
 TEST(CellIndex, OneRadiusForAllEqualsAnArrayOfIt) {
