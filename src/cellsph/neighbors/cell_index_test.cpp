@@ -273,7 +273,7 @@ TEST(CellIndex, DenseCellsGiveAscendingRowsFromAnIndexSortedBlock) {
 // Supports of 3.2 spacings: rows of ~137 neighbours from blocks on both sides of the 256 candidates
 // whose hit masks find_all keeps in its work buffer (H = 3; longer blocks keep theirs in the spill),
 // so rows longer than the rank sort takes are packed from kept masks of both kinds.
-TEST(CellIndex, LongRowsFromKeptAndRetestedHitMasks) {
+TEST(CellIndex, LongRowsFromHitMasksKeptInTheBufferAndTheSpill) {
   const auto x = point_sets::jittered_lattice<3, float>(1728, 1.0f, 0.2f);
   expect_exact<3, float>(x, std::vector<float>(x.size(), 3.2f), "3D float h = 3.2 spacings");
   std::vector<float> h(x.size(), 3.2f);
