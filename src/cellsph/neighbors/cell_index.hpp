@@ -18,8 +18,9 @@
 // Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
 // a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
 // (SSE2) at a time and walks the set bits of the hit mask, with no branch per candidate. find_all
-// counts, keeping the hit masks of blocks of up to 256 candidates, then fills from them (distance
-// tests again only for longer blocks), and places each short row by rank.
+// counts, keeping every particle's hit masks (blocks of up to 256 candidates in a work buffer, longer
+// ones in a spill per traversal chunk), then fills the rows from them with no second distance test,
+// and sorts each row of up to 64 in registers (sort_network.hpp), up to 96 by rank.
 //
 // Exactness: the neighbour test is distance2(x[i], x[j]) <= h[i]^2 in Real, the same expression as
 // the all-pairs reference; the mask only decides which candidates reach that test, and it is built
@@ -60,6 +61,7 @@
 #include "cellsph/neighbors/hmask.hpp"
 #include "cellsph/neighbors/neighbor_list.hpp"
 #include "cellsph/neighbors/radix_sort.hpp"
+#include "cellsph/neighbors/sort_network.hpp"
 
 namespace cellsph {
 
@@ -347,7 +349,7 @@ class CellIndex {
         if (sort) std::sort(buf, buf + len);
         std::memcpy(row, buf, len * sizeof(std::uint32_t));
       } else if (sort) {
-        rank_sort(buf, static_cast<std::uint32_t>(len), row);
+        sort_row(buf, static_cast<std::uint32_t>(len), row);
       } else {
         if (len > 0)
           std::memcpy(row, buf, len * sizeof(std::uint32_t));  // row is null when no list has pairs
@@ -656,6 +658,18 @@ class CellIndex {
     v = (v & 0x3333333333333333ull) + ((v >> 2) & 0x3333333333333333ull);
     v = (v + (v >> 4)) & 0x0F0F0F0F0F0F0F0Full;
     return (v * 0x0101010101010101ull) >> 56;
+  }
+
+  // Sorts the distinct values in[0, L) (L <= kRankSortMax) into out: rows of up to 64 with a sorting
+  // network where AVX2 is, others by rank. in must have room for kRankSortMax + 8 entries.
+  void sort_row(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) const {
+#if defined(CELLSPH_SORT_NETWORK_AVX2) && defined(CELLSPH_CELL_INDEX_AVX2)
+    if (avx2_ && L <= 64) {
+      if (L > 0) detail::sort_row_avx2(in, L, out);
+      return;
+    }
+#endif
+    rank_sort(in, L, out);
   }
 
   // Sorts the distinct values in[0, L) into out by rank: out[#{m : in[m] < in[k]}] = in[k]. No

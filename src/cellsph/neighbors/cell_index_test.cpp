@@ -343,6 +343,34 @@ TEST(CellIndex, RankSortOrdersEveryRowLength) {
 }
 #endif
 
+#if defined(CELLSPH_SORT_NETWORK_AVX2)
+// The bitonic networks that order rows of up to 64 (one, two, four or eight registers), on every
+// length, values across the whole unsigned range, against std::sort. The entries past L that it reads
+// hold small values, which would sort first were they not ignored; nothing past out[L - 1] is written.
+TEST(CellIndex, SortNetworkOrdersEveryRowLength) {
+  if (!detail::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: the rank sort runs instead";
+  std::mt19937 rng(64);
+  for (std::uint32_t L = 1; L <= 64; ++L)
+    for (int rep = 0; rep < 40; ++rep) {
+      std::vector<std::uint32_t> v;
+      while (v.size() < L) {
+        const auto x = static_cast<std::uint32_t>(rep % 2 ? rng() : rng() % 100);
+        if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+      }
+      if (rep == 2) std::sort(v.begin(), v.end());    // already ascending
+      if (rep == 3) std::sort(v.rbegin(), v.rend());  // descending
+      std::vector<std::uint32_t> in(v);
+      in.resize(64, 0u);
+      std::vector<std::uint32_t> out(L + 8, 0xABCDEFu);
+      detail::sort_row_avx2(in.data(), L, out.data());
+      std::sort(v.begin(), v.end());
+      ASSERT_EQ(std::vector<std::uint32_t>(out.begin(), out.begin() + L), v)
+          << "L = " << L << ", rep " << rep;
+      for (std::uint32_t t = L; t < L + 8; ++t) ASSERT_EQ(out[t], 0xABCDEFu) << "wrote past L = " << L;
+    }
+}
+#endif
+
 // One support for all, given as a number (no array kept) or as an array: the same lists; a bad
 // number is refused as a bad array is.
 TEST(CellIndex, OneRadiusForAllEqualsAnArrayOfIt) {
