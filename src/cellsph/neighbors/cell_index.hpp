@@ -55,6 +55,7 @@
 #endif
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/fresh_memory.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/csr_builder.hpp"
@@ -550,13 +551,14 @@ class CellIndex {
       parallel_for(n, [&](std::size_t p) { ids_[p] = static_cast<std::uint32_t>(keys[p] & low); });
       parallel_for(n, [&](std::size_t p) { keys[p] >>= I; });
     } else {
-      std::vector<std::uint32_t> payload_scratch;
+      std::vector<std::uint32_t> payload(n), payload_scratch;
       wide_keys.resize(n);
       parallel_for(n, [&](std::size_t i) {
         wide_keys[i] = cell_key(x[i], pad);
-        ids_[i] = static_cast<std::uint32_t>(i);
+        payload[i] = static_cast<std::uint32_t>(i);
       });
-      radix_sort_pairs(wide_keys, ids_, scratch, payload_scratch, 0, cell_bits_);
+      radix_sort_pairs(wide_keys, payload, scratch, payload_scratch, 0, cell_bits_);
+      parallel_for(n, [&](std::size_t p) { ids_[p] = payload[p]; });
       keys = wide_keys.data();
     }
     // keys now holds each particle's cell key in sorted order: extract the distinct cells.
@@ -638,18 +640,6 @@ class CellIndex {
       s += d * d;
     }
     return s;
-  }
-
-  // Asks Linux to back a fresh, still untouched list with 2 MiB pages (THP in "madvise" mode):
-  // first-touching 10^8 bytes in 4 KiB pages costs tens of ms of page faults. Only a hint.
-  static void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    constexpr std::uintptr_t kHuge = std::uintptr_t{1} << 21;
-    if (bytes < 2 * kHuge) return;
-    const auto a = reinterpret_cast<std::uintptr_t>(p);
-    const std::uintptr_t b = (a + kHuge - 1) & ~(kHuge - 1), e = (a + bytes) & ~(kHuge - 1);
-    if (e > b) madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
-#endif
   }
 
   static std::uint64_t popcount64(std::uint64_t v) {
@@ -1158,10 +1148,10 @@ class CellIndex {
   std::vector<std::uint64_t> deltas_;      // key offset of each mask cell, mod 2^64
   std::vector<std::uint64_t> cells_;       // distinct cell keys in order, + UINT64_MAX sentinel
   std::vector<std::uint32_t> cell_start_;  // first particle (key order) of each cell, + n
-  std::array<std::vector<Real>, Dim> xs_;  // positions in key order, one array per axis
+  std::array<FreshVector<Real>, Dim> xs_;  // positions in key order, one array per axis
   std::vector<Real> hs_;                   // support lengths in key order (empty when all are hmax_)
   std::vector<std::uint8_t> zero_cell_;    // 1: every particle of the cell has support 0
-  std::vector<std::uint32_t> ids_;         // key order -> particle index
+  FreshVector<std::uint32_t> ids_;         // key order -> particle index
   // The sort's keys and second buffer in build, find_all's kept hit masks (kStoreWords words a
   // particle) after: kept from one build to the next.
   mutable WorkBuffer work_;
