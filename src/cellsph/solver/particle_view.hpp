@@ -60,6 +60,7 @@ struct ParticleView {
   Real* df_grad = nullptr;        // DFSPH: W'(r)/r of each pair of the rows (grad W = x_ij times it), at the
                                   // pair's slot in `within`
   V* df_gsum = nullptr;           // DFSPH: sum_j w_ij grad W_ij of the step (the density pass)
+  V* df_gwall = nullptr;          // DFSPH: its walls' part, sum_b w_ib grad W_ib
   V* df_mv = nullptr;             // DFSPH: w_j v_j (the mass density's sweeps gather it)
   Real* df_mk = nullptr;          // DFSPH: m_j k_j of the sweep, 0 for a wall
 

@@ -310,6 +310,7 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.df_kappa_v = state_.dfsph_kappa_v.data();
   v.df_grad = df_grad_.data();
   v.df_gsum = df_gsum_.data();
+  v.df_gwall = df_gwall_.data();
   v.df_mv = df_mv_.data();
   v.df_mk = df_mk_.data();
   v.offsets = nl_.offsets.data();
@@ -699,6 +700,7 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   df_kappa_.resize(n);
   df_grad_.resize(nl_.indices.size());
   df_gsum_.resize(n);
+  df_gwall_.resize(n);
   df_mv_.resize(n);
   df_mk_.resize(n);
   if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);

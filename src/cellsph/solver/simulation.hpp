@@ -321,8 +321,8 @@ class Simulation {
   // Per pair slot of the rows (nl_.indices.size()): the step's kernel gradients as W'(r)/r (one scalar,
   // not the vector: a third of the bytes in 3D; the vector is x_ij times it).
   std::vector<Real> df_grad_;
-  std::vector<V> df_gsum_, df_mv_;  // DFSPH: per-step sums and the sweeps' gathered w_j v_j
-  std::vector<Real> df_mk_;         // DFSPH: the sweeps' gathered m_j k_j
+  std::vector<V> df_gsum_, df_gwall_, df_mv_;  // DFSPH: per-step sums and the sweeps' gathered w_j v_j
+  std::vector<Real> df_mk_;                    // DFSPH: the sweeps' gathered m_j k_j
   Real df_diameter_ = 0;
   DfsphStats dfsph_stats_;
 

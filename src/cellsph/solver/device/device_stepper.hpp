@@ -234,6 +234,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.df_kappa_v = df_kappa_v_.data();
     v.df_grad = df_grad_.data();
     v.df_gsum = df_gsum_.data();
+    v.df_gwall = df_gwall_.data();
     v.df_mv = df_mv_.data();
     v.df_mk = df_mk_.data();
     v.offsets = offsets_.data();
@@ -303,6 +304,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     }
     df_grad_.resize(rows_.size());
     df_gsum_.resize(n_);
+    df_gwall_.resize(n_);
     df_mv_.resize(n_);
     df_mk_.resize(n_);
     return dfsph_step(cfg_, view(), fluid, DeviceRange<Space>{n_}, in.dfsph_diameter, *in.dfsph, in.step);
@@ -437,7 +439,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   std::vector<std::uint32_t> fluid_host_;
   Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
   Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_grad_, df_mk_;  // DFSPH (models/dfsph.hpp)
-  Array<V> df_gsum_, df_mv_;
+  Array<V> df_gsum_, df_gwall_, df_mv_;
   Array<V> f_pressure_, wall_v_, normal_;
   // Moving walls: the config's motions and table rows; per moving wall its slot, initial position, motion;
   // every particle's wall acceleration (empty when nothing moves).

@@ -142,6 +142,7 @@ struct DfsphDensityFactorPass {
   Kernel w;
   Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
   bool number;       // number density (DensityFormulation::Number)
+  bool mirror;       // walls' k mirrored from the fluid particle's (SolverConfig::Dfsph::mirror_walls)
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -150,7 +151,7 @@ struct DfsphDensityFactorPass {
     const V xi = pv.x[i];
     const Real mi = pv.m[i];
     Real rho = density_term(w, mi, Real(0));
-    V grad{};
+    V grad{}, gwall{};
     Real sq = 0;
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
@@ -163,13 +164,21 @@ struct DfsphDensityFactorPass {
       const V mg = g * wj;
       grad += mg;
       // |grad_j rho_i|^2 m_i / m_j: m_i = m_j for the mass density of one phase (the 2015 paper's sum).
-      if (pv.is_fluid(j)) sq += number ? norm2(mg) * (mi / pv.m[j]) : norm2(mg);
+      if (pv.is_fluid(j))
+        sq += number ? norm2(mg) * (mi / pv.m[j]) : norm2(mg);
+      else
+        gwall += mg;
     }
-    const Real denom = norm2(grad) + sq;
+    // k_i's own effect on D rho_i / Dt: its kick is -dt k_i (G_i + B_i) with the walls mirrored (B_i their
+    // part of G_i), -dt k_i G_i without; so the diagonal is (G_i + B_i) . G_i + sq, or |G_i|^2 + sq. Next
+    // to a wall G_i is small and (G_i + B_i) . G_i may be negative: then sq alone, a larger diagonal than
+    // the true one (a shorter Jacobi step, never an overshoot).
+    const Real denom = (mirror ? std::max(dot(grad + gwall, grad), Real(0)) : norm2(grad)) + sq;
     pv.rho[i] = rho;
     pv.vol[i] = pv.m[i] / rho;
     pv.df_alpha[i] = denom > denom_floor ? Real(1) / denom : Real(0);
     pv.df_gsum[i] = grad;
+    pv.df_gwall[i] = gwall;
     pv.prho2[i] = warm;
   }
 };
@@ -220,6 +229,7 @@ struct DfsphPressureKickPass {
   Real dt;
   Real* acc;
   bool number;  // number density (DensityFormulation::Number)
+  bool mirror;  // a wall's k is k_i (else 0)
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -227,7 +237,7 @@ struct DfsphPressureKickPass {
     const V xi = pv.x[i];
     acc[i] += ki;
     if (!number) {  // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
-      V s = pv.df_gsum[i] * ki;
+      V s = (mirror ? V(pv.df_gsum[i] + pv.df_gwall[i]) : pv.df_gsum[i]) * ki;
       for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
         s += dfsph_grad(pv, xi, it) * pv.df_mk[*it];
       pv.v[i] -= s * dt;
@@ -241,7 +251,9 @@ struct DfsphPressureKickPass {
         f += number_density_pressure_force(dfsph_grad(pv, xi, it), mi, pv.m[j], ki, pv.df_kappa[j]);
       else
         f += symmetric_pressure_force(dfsph_grad(pv, xi, it), mi, dfsph_weight(pv, number, i, j), ki,
-                                      pv.is_fluid(j) ? pv.df_kappa[j] : Real(0));
+                                      pv.is_fluid(j) ? pv.df_kappa[j]
+                                      : mirror       ? ki
+                                                     : Real(0));
     }
     pv.v[i] += f * (dt / mi);
     pv.df_mv[i] = pv.v[i] * mi;
@@ -310,8 +322,8 @@ struct DfsphSolveResult {
 template <int Dim, class Real, class Kernel, class Set>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
-                             std::uint32_t min_neighbors, bool number) {
-  const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number};
+                             std::uint32_t min_neighbors, bool number, bool mirror) {
+  const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number, mirror};
   // Half the last step's k, as SPlisHSPlasH: the full sum (measured) set the hydrostatic column and the
   // dam break ringing.
   run_pass(set, DfsphSourcePass<Dim, Real, Kernel>{pv, w, dt, density, true, Real(warm_start ? 0.5 : 0.0),
@@ -359,13 +371,14 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
   const double eta_density = double(cfg.dfsph.max_density_error) / 100;
   const double eta_divergence = double(cfg.dfsph.max_divergence_error) / 100;
   const bool number = cfg.density == DensityFormulation::Number;
+  const bool mirror = cfg.dfsph.mirror_walls;
 
   Real dt = 0;
   with_kernel<Dim, Real>(cfg.density_kernel, h, [&](const auto w) {
     using K = std::remove_cvref_t<decltype(w)>;
     Stopwatch sw;
     const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
-    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor, number});
+    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor, number, mirror});
     if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
@@ -397,7 +410,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     };
     const DfsphSolveResult div =
         dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
-                    cfg.dfsph.warm_start, min_neighbors, number);
+                    cfg.dfsph.warm_start, min_neighbors, number, mirror);
     check(div, eta_divergence, "divergence-free");
     st.ms_divergence += sw.ms();
     sw.reset();
@@ -410,7 +423,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
 
     const DfsphSolveResult den =
         dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
-                    cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors, number);
+                    cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors, number, mirror);
     check(den, eta_density, "constant-density");
     st.ms_density += sw.ms();
     sw.reset();
