@@ -319,6 +319,17 @@ TEST(CellIndex, LongBlocksKeepTheirHitMasksInTheSpill) {
   }
 }
 
+// L distinct values: from [0, small) on even draws, from the whole unsigned range on odd ones.
+[[maybe_unused]] std::vector<std::uint32_t> distinct_values(std::mt19937& rng, std::uint32_t L, int rep,
+                                                            std::uint32_t small) {
+  std::vector<std::uint32_t> v;
+  while (v.size() < L) {
+    const auto x = static_cast<std::uint32_t>(rep % 2 ? rng() : rng() % small);
+    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+  }
+  return v;
+}
+
 #if defined(CELLSPH_CELL_INDEX_AVX2)
 // The AVX2 rank sort that orders short rows, on every length up to its limit (one to four registers a
 // block, one to three blocks), distinct values on both sides of 2^31 (the signed compare's bias),
@@ -328,11 +339,7 @@ TEST(CellIndex, RankSortOrdersEveryRowLength) {
   std::mt19937 rng(96);
   for (std::uint32_t L = 1; L <= 96; ++L)
     for (int rep = 0; rep < 20; ++rep) {
-      std::vector<std::uint32_t> v;
-      while (v.size() < L) {
-        const auto x = static_cast<std::uint32_t>(rep % 2 ? rng() : rng() % 200);
-        if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
-      }
+      std::vector<std::uint32_t> v = distinct_values(rng, L, rep, 200);
       std::vector<std::uint32_t> in(v);
       in.resize(L + 8, 0xFFFFFFFFu);  // the 8 entries past L it may read
       std::vector<std::uint32_t> out(L, 0);
@@ -352,11 +359,7 @@ TEST(CellIndex, SortNetworkOrdersEveryRowLength) {
   std::mt19937 rng(64);
   for (std::uint32_t L = 1; L <= 64; ++L)
     for (int rep = 0; rep < 40; ++rep) {
-      std::vector<std::uint32_t> v;
-      while (v.size() < L) {
-        const auto x = static_cast<std::uint32_t>(rep % 2 ? rng() : rng() % 100);
-        if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
-      }
+      std::vector<std::uint32_t> v = distinct_values(rng, L, rep, 100);
       if (rep == 2) std::sort(v.begin(), v.end());    // already ascending
       if (rep == 3) std::sort(v.rbegin(), v.rend());  // descending
       std::vector<std::uint32_t> in(v);
