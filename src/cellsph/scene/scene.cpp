@@ -530,7 +530,9 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     d.min_iterations = static_cast<int>(dr.integer("min_iterations", d.min_iterations, 0, 100000));
     d.max_iterations = static_cast<int>(dr.integer("max_iterations", d.max_iterations, 1, 100000));
     d.warm_start = dr.boolean("warm_start", d.warm_start);
-    d.mirror_walls = dr.choice("wall_pressure", "zero", {"zero", "mirrored"}) == "mirrored";
+    const std::string wall_pressure = dr.choice("wall_pressure", "zero", {"zero", "mirrored", "hydrostatic"});
+    d.mirror_walls = wall_pressure != "zero";
+    d.hydrostatic_walls = wall_pressure == "hydrostatic";
     if (d.min_iterations > d.max_iterations)
       dr.fail("min_iterations", "value " + std::to_string(d.min_iterations) + " exceeds max_iterations " +
                                     std::to_string(d.max_iterations));

@@ -213,11 +213,14 @@ struct SolverConfig {
     int min_iterations = 2;
     int max_iterations = 100;
     bool warm_start = true;
-    // A wall particle's k in the pressure kick (`wall_pressure`): 0 ("zero", Akinci 2012 as SPlisHSPlasH:
-    // the fluid row next to a wall then carries the column on half the terms, and its pressure is ~1.8x
-    // rho0 g d) or the fluid particle's own ("mirrored": the wall's pressure extrapolated from the fluid at
-    // zeroth order; that row's pressure within ~6% of rho0 g d, for ~15-30% more sweeps a step).
+    // A wall particle's pressure in the pressure force (`wall_pressure`): 0 ("zero", Akinci 2012 as
+    // SPlisHSPlasH: the fluid row next to a wall then carries the column on half the terms, and its
+    // pressure is ~1.8x rho0 g d); the fluid particle's own ("mirrored": extrapolated at zeroth order, that
+    // row ~6% over rho0 g d); or that plus the hydrostatic rise to the wall particle, rho_i g . (x_b - x_i)
+    // ("hydrostatic", Adami's extrapolation for walls at rest, applied once a step with the non-pressure
+    // forces).
     bool mirror_walls = false;
+    bool hydrostatic_walls = false;  // only with mirror_walls
   } dfsph{};
 
   SearchOptions search{};

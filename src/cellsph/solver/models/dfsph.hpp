@@ -270,6 +270,7 @@ struct DfsphNonPressurePass {
   bool no_slip;
   bool
       number;  // number density: a wall's volume is its weight rho0_i V_b over rho_i, i.e. V_b rho0_i / rho_i
+  bool hydrostatic;  // walls' pressure p_i + rho_i g . (x_b - x_i): its g part here, once a step
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -281,11 +282,15 @@ struct DfsphNonPressurePass {
       const V xij = xi - pv.x[j];
       const Real r = norm(xij);
       const V g = xij * pv.df_grad[it - pv.within];
-      if (pv.is_fluid(j))
+      if (pv.is_fluid(j)) {
         f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
-      else if (no_slip)
-        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, dfsph_weight(pv, number, i, j) / rhoi,
-                                    mui, mui, eta2);
+        continue;
+      }
+      const Real wb = dfsph_weight(pv, number, i, j);
+      if (no_slip) f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, wb / rhoi, mui, mui, eta2);
+      // The pressure force's wall term -m_i w_b (p_b / rho_i^2) grad W_ib for the part of p_b beyond p_i
+      // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i g . (x_b - x_i).
+      if (hydrostatic) f -= g * (pv.m[i] * wb * dot(gravity, V(pv.x[j] - xi)) / rhoi);
     }
     pv.f[i] = f;
   }
@@ -415,8 +420,9 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     st.ms_divergence += sw.ms();
     sw.reset();
 
-    run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2),
-                                                       cfg.no_slip, number});
+    run_pass(fluid,
+             DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2),
+                                                cfg.no_slip, number, mirror && cfg.dfsph.hydrostatic_walls});
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
     st.ms_nonpressure += sw.ms();
     sw.reset();
