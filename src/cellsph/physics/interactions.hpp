@@ -159,21 +159,21 @@ CELLSPH_HD inline Vec<Dim, Real> symmetric_pressure_force(const PairInput<Dim, R
 //   f_i = sum_j m_i m_j (mu_i + mu_j) / (rho_i rho_j) (x_ij . grad W_ij) / (|x_ij|^2 + eta2) v_ij,
 // i.e. m_i / rho_i div(mu grad v) with the Laplacian above (for equal mu, m_i mu / rho_i lap v). Written with
 // V_i V_j and F_ij / (2 V_j): f_ij = -f_ji exactly (momentum); it acts along v_ij, not x_ij, so it does not
-// conserve angular momentum exactly (Morris's operator).
+// conserve angular momentum exactly (Morris's operator). r2 = |x_ij|^2.
 template <int Dim, class Real>
 CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const Vec<Dim, Real>& vij,
                                                         const Vec<Dim, Real>& grad_w,
-                                                        const Vec<Dim, Real>& xij, Real r, Real vol_i,
+                                                        const Vec<Dim, Real>& xij, Real r2, Real vol_i,
                                                         Real vol_j, Real mui, Real muj, Real eta2) {
-  return vij * (vol_i * vol_j * (mui + muj) * dot(xij, grad_w) / (r * r + eta2));
+  return vij * (vol_i * vol_j * (mui + muj) * dot(xij, grad_w) / (r2 + eta2));
 }
 
 // hs: the smoothing length (support / 2) of the 0.01 hs^2 regulariser.
 template <int Dim, class Real, class Kernel>
 CELLSPH_HD inline Vec<Dim, Real> morris_viscosity_force(const PairInput<Dim, Real>& in, const Kernel& w,
                                                         Real hs) {
-  return morris_viscosity_force(in.vij, w.gradW(in.xij), in.xij, in.r, in.mi / in.rhoi, in.mj / in.rhoj,
-                                in.mui, in.muj, Real(0.01) * hs * hs);
+  return morris_viscosity_force(in.vij, w.gradW(in.xij), in.xij, in.r * in.r, in.mi / in.rhoi,
+                                in.mj / in.rhoj, in.mui, in.muj, Real(0.01) * hs * hs);
 }
 
 // Monaghan's (1992) artificial viscosity, for approaching pairs (v_ij . x_ij < 0) only:

@@ -50,6 +50,12 @@ CELLSPH_HD inline Vec<Dim, Real> radial(const Vec<Dim, Real>& rv, Real r, Real d
 }
 }  // namespace detail
 
+// W(|r|) and W'(|r|)/|r| of one pair (kernel_value_and_factor).
+template <class Real>
+struct KernelValueAndFactor {
+  Real value, factor;
+};
+
 // Poly6 (Mueller 2003; paper eq. 10, 18): density and colour field.
 template <int Dim, class Real>
 struct Poly6Kernel {
@@ -204,6 +210,19 @@ struct CubicSplineKernel {
     const Real r = norm(rv);
     return r > Real(0) ? dW(r) / r : Real(0);
   }
+  // W2(r2) and gradW_factor of a vector of squared length r2, with their bits, from one square root and
+  // without a branch a pair would take or not (both pieces are computed, then selected).
+  CELLSPH_HD KernelValueAndFactor<Real> value_and_factor(Real r2) const {
+    const Real r = std::sqrt(r2);
+    const Real q = r * inv_h;
+    const Real d = 1 - q;
+    const bool inner = q <= Real(0.5), inside = !(q > 1), positive = r > Real(0);
+    const Real w = inner ? sigma * (Real(6) * (q * q * q - q * q) + 1) : sigma * Real(2) * d * d * d;
+    const Real dw =
+        inner ? sigma * inv_h * Real(6) * (Real(3) * q * q - Real(2) * q) : sigma * inv_h * Real(-6) * d * d;
+    const Real f = dw / (positive ? r : Real(1));
+    return {inside ? w : Real(0), inside && positive ? f : Real(0)};
+  }
   // Finite at r = 0 from the limit W'(r)/r -> -12 sigma / h^2.
   CELLSPH_HD Real laplacian(Real r) const {
     const Real q = r * inv_h;
@@ -252,6 +271,13 @@ struct WendlandC2Kernel {
     const Real d = 1 - q;
     return Real(-20) * sigma * inv_h * inv_h * d * d * d;
   }
+  // W2(r2) and gradW_factor with their bits, from one square root (as CubicSplineKernel's).
+  CELLSPH_HD KernelValueAndFactor<Real> value_and_factor(Real r2) const {
+    const Real q = std::sqrt(r2) * inv_h;
+    const Real d = 1 - q, d2 = d * d;
+    if (q > 1) return {Real(0), Real(0)};
+    return {sigma * d2 * d2 * (1 + Real(4) * q), Real(-20) * sigma * inv_h * inv_h * d * d * d};
+  }
   CELLSPH_HD Real laplacian(Real r) const {
     const Real q = r * inv_h;
     if (q > 1) return 0;
@@ -280,6 +306,17 @@ struct CohesionKernel {
     return norm * (2 * a - h3 * h3 / 64);
   }
 };
+
+// W(|rv|) and W'(|rv|)/|rv| of one pair, r2 = |rv|^2: the bits of k.W2(r2) and k.gradW_factor(rv), from one
+// square root where the kernel has value_and_factor.
+template <class Kernel, int Dim, class Real>
+CELLSPH_HD inline KernelValueAndFactor<Real> kernel_value_and_factor(const Kernel& k,
+                                                                     const Vec<Dim, Real>& rv, Real r2) {
+  if constexpr (requires { k.value_and_factor(r2); })
+    return k.value_and_factor(r2);
+  else
+    return {k.W2(r2), k.gradW_factor(rv)};
+}
 
 // Calls f(kernel) with the kernel of the given kind: the one run-time switch, taken once per loop, so
 // the per-neighbour code is inlined for a concrete kernel type.

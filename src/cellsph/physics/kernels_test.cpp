@@ -205,6 +205,48 @@ TEST(Kernels, GradientFactorRebuildsTheGradientsBits) {
   check_gradient_factor<3, double>();
 }
 
+// kernel_value_and_factor (one square root, selects for branches) gives W2's and gradW_factor's bits, at
+// random points, at r = 0, at the cubic spline's seam q = 1/2 and at the support's edge.
+template <int Dim, class Real>
+void check_value_and_factor() {
+  std::uint64_t state = 777;
+  auto uniform = [&state] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) / double(1ull << 53);
+  };
+  for (const KernelKind kind : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity,
+                                KernelKind::CubicSpline, KernelKind::WendlandC2}) {
+    with_kernel<Dim, Real>(kind, Real(kH), [&](const auto w) {
+      for (int k = 0; k < 2004; ++k) {
+        Vec<Dim, Real> rv{};
+        if (k < 2000) {
+          for (int a = 0; a < Dim; ++a) rv[a] = Real((2 * uniform() - 1) * 1.2 * kH);
+        } else if (k > 2000) {  // 0.5 h, h, and the next value past h
+          rv[0] = k == 2001 ? Real(kH / 2) : k == 2002 ? Real(kH) : std::nextafter(Real(kH), Real(1));
+        }
+        const Real r2 = norm2(rv);
+        const auto both = kernel_value_and_factor(w, rv, r2);
+        const Real value = w.W2(r2), factor = w.gradW_factor(rv);
+        ASSERT_EQ(std::memcmp(&both.value, &value, sizeof(Real)), 0)
+            << kernel_name(kind) << " " << Dim << "D sample " << k << ": W " << both.value << " vs " << value;
+        ASSERT_TRUE(both.factor == factor)  // equal, and the same bits unless both are zero (-0 == 0)
+            << kernel_name(kind) << " " << Dim << "D sample " << k << ": W'/r " << both.factor << " vs "
+            << factor;
+        if (factor != 0) {
+          ASSERT_EQ(std::memcmp(&both.factor, &factor, sizeof(Real)), 0) << kernel_name(kind);
+        }
+      }
+    });
+  }
+}
+
+TEST(Kernels, ValueAndFactorHaveTheSeparateFunctionsBits) {
+  check_value_and_factor<2, float>();
+  check_value_and_factor<2, double>();
+  check_value_and_factor<3, float>();
+  check_value_and_factor<3, double>();
+}
+
 TEST(Kernels, NamesRoundTrip) {
   for (auto k : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity, KernelKind::CubicSpline,
                  KernelKind::WendlandC2})

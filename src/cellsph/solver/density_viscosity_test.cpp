@@ -63,7 +63,7 @@ V2 morris_on_quadratic(double ratio, bool regularised) {
       if (r > h) continue;
       const double yj = yi + ky * s;
       const V2 vij{{yi * yi - yj * yj, 0}};
-      f += morris_viscosity_force(vij, w.gradW(xij), xij, r, s * s, s * s, mu, mu,
+      f += morris_viscosity_force(vij, w.gradW(xij), xij, r * r, s * s, s * s, mu, mu,
                                   regularised ? 0.01 * hs * hs : 0.0);
     }
   return f * (1 / (rho0 * s * s)) * (rho0 / mu);  // a = f / m, as a multiple of mu / rho0: lap u

@@ -122,9 +122,9 @@ CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>
   return d;
 }
 
-// Once a step, after the density pass, for every particle: w_j v_j and m_j k_j = 0 (the walls keep them
-// through the step; the fluid's are rewritten by the passes that change v and k). The mass density's sweeps
-// read them; the number density's do not, so its step skips this pass.
+// Once a step, before the density pass, for every particle: w_j v_j and m_j k_j = 0 (the walls keep them
+// through the step; the fluid's are rewritten by the passes that change v and k). The mass density's
+// passes read them; the number density's do not, so its step skips this pass.
 template <int Dim, class Real>
 struct DfsphPairStatePass {
   ParticleView<Dim, Real> pv;
@@ -134,72 +134,22 @@ struct DfsphPairStatePass {
   }
 };
 
-// Step 1: density, volume, alpha, and the density solve's warm start k = p / rho^2 of the last step
-// (read before rho is overwritten; p and rho are particle fields, so a checkpoint carries it).
-template <int Dim, class Real, class Kernel>
-struct DfsphDensityFactorPass {
-  ParticleView<Dim, Real> pv;
-  Kernel w;
-  Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
-  bool number;       // number density (DensityFormulation::Number)
-  bool mirror;       // walls' k mirrored from the fluid particle's (SolverConfig::Dfsph::mirror_walls)
-
-  CELLSPH_HD void operator()(std::size_t i) const {
-    using V = Vec<Dim, Real>;
-    const Real rho_old = pv.rho[i];
-    const Real warm = rho_old > 0 ? pv.p[i] / (rho_old * rho_old) : Real(0);
-    const V xi = pv.x[i];
-    const Real mi = pv.m[i];
-    Real rho = density_term(w, mi, Real(0));
-    V grad{}, gwall{};
-    Real sq = 0;
-    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
-      const std::uint32_t j = *it;
-      const V xij = xi - pv.x[j];
-      const Real wj = dfsph_weight(pv, number, i, j);
-      rho += density_term(w, wj, norm2(xij));
-      const Real gs = w.gradW_factor(xij);
-      pv.df_grad[it - pv.within] = gs;  // the step's gradients, read by every sweep (positions fixed)
-      const V g = xij * gs;             // = w.gradW(xij), bit for bit
-      const V mg = g * wj;
-      grad += mg;
-      // |grad_j rho_i|^2 m_i / m_j: m_i = m_j for the mass density of one phase (the 2015 paper's sum).
-      if (pv.is_fluid(j))
-        sq += number ? norm2(mg) * (mi / pv.m[j]) : norm2(mg);
-      else
-        gwall += mg;
-    }
-    // k_i's own effect on D rho_i / Dt: its kick is -dt k_i (G_i + B_i) with the walls mirrored (B_i their
-    // part of G_i), -dt k_i G_i without; so the diagonal is (G_i + B_i) . G_i + sq, or |G_i|^2 + sq. Next
-    // to a wall G_i is small and (G_i + B_i) . G_i may be negative: then sq alone, a larger diagonal than
-    // the true one (a shorter Jacobi step, never an overshoot).
-    const Real denom = (mirror ? std::max(dot(grad + gwall, grad), Real(0)) : norm2(grad)) + sq;
-    pv.rho[i] = rho;
-    pv.vol[i] = pv.m[i] / rho;
-    pv.df_alpha[i] = denom > denom_floor ? Real(1) / denom : Real(0);
-    pv.df_gsum[i] = grad;
-    pv.df_gwall[i] = gwall;
-    pv.prho2[i] = warm;
-  }
-};
-
-// The source of a sweep: writes k_i = source * alpha / dt^2 (density) or / dt (divergence) to df_kappa
-// and returns i's error (relative to rho0; per step for the divergence). In warm mode instead: k_i = half
-// the accumulated k where the source is positive (0 elsewhere), and the accumulator restarts at 0.
-template <int Dim, class Real, class Kernel>
-struct DfsphSourcePass {
-  ParticleView<Dim, Real> pv;
-  Kernel w;
+// The source of a sweep from i's rate D rho_i / Dt: writes k_i = source * alpha / dt^2 (density) or / dt
+// (divergence) to df_kappa and returns i's error (relative to rho0; per step for the divergence). In warm
+// mode instead: k_i = half the accumulated k where the source is positive (0 elsewhere), and the
+// accumulator restarts at 0. DfsphSourcePass applies it; the density pass too, for the divergence solve's
+// warm start.
+template <class Real>
+struct DfsphSourceRule {
   Real dt;
   bool density;                 // constant-density solve (else divergence-free)
   bool warm;                    // warm-start mode
   Real warm_scale;              // 0.5, or 0 without warm starts
   Real* acc;                    // the solve's accumulated k: pv.prho2 (density) or pv.df_kappa_v (divergence)
   std::uint32_t min_neighbors;  // divergence: fewer neighbours, no correction (splashes)
-  bool number;                  // number density (DensityFormulation::Number)
 
-  CELLSPH_HD Real operator()(std::size_t i) const {
-    const Real rate = number ? dfsph_density_rate(pv, i, number) : dfsph_density_rate_factored(pv, i);
+  template <int Dim>
+  CELLSPH_HD Real apply(const ParticleView<Dim, Real>& pv, std::size_t i, Real rate) const {
     const Real rho0 = pv.rho0[i];
     Real source = 0;
     if (density) {
@@ -218,6 +168,79 @@ struct DfsphSourcePass {
     pv.df_mk[i] = pv.m[i] * k;
     if (warm) return 0;
     return density ? source / rho0 : source * dt / rho0;
+  }
+};
+
+// Step 1: density, volume, alpha, and the density solve's warm start k = p / rho^2 of the last step
+// (read before rho is overwritten; p and rho are particle fields, so a checkpoint carries it). For the mass
+// density it also takes the divergence solve's warm-start pass (fold_warm): that pass's rate is
+// v_i . G_i - sum_j (w_j v_j) . grad W_ij with the velocities of the step's start, so its pair sum can ride
+// along this loop (DfsphPairStatePass has written every w_j v_j before), one traversal of the rows less.
+template <int Dim, class Real, class Kernel>
+struct DfsphDensityFactorPass {
+  ParticleView<Dim, Real> pv;
+  Kernel w;
+  Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
+  bool number;       // number density (DensityFormulation::Number)
+  bool mirror;       // walls' k mirrored from the fluid particle's (SolverConfig::Dfsph::mirror_walls)
+  bool fold_warm;    // also the divergence solve's warm start, by warm_divergence (mass density only)
+  DfsphSourceRule<Real> warm_divergence;
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    using V = Vec<Dim, Real>;
+    const Real rho_old = pv.rho[i];
+    const Real warm = rho_old > 0 ? pv.p[i] / (rho_old * rho_old) : Real(0);
+    const V xi = pv.x[i];
+    const Real mi = pv.m[i];
+    Real rho = density_term(w, mi, Real(0));
+    V grad{}, gwall{};
+    Real sq = 0, mv_sum = 0;
+    // Two loops over the row, the second reading back the first's gradients: one loop kept too many sums
+    // live for the registers, and it carried them through memory (measured).
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+      const V xij = xi - pv.x[*it];
+      const auto k = kernel_value_and_factor(w, xij, norm2(xij));
+      rho += dfsph_weight(pv, number, i, *it) * k.value;  // density_term(w, w_ij, |x_ij|^2), bit for bit
+      pv.df_grad[it - pv.within] = k.factor;  // the step's gradients, read by every sweep (positions fixed)
+    }
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+      const std::uint32_t j = *it;
+      const Real wj = dfsph_weight(pv, number, i, j);
+      const V g = dfsph_grad(pv, xi, it);  // = w.gradW(x_ij), bit for bit
+      const V mg = g * wj;
+      grad += mg;
+      if (fold_warm) mv_sum += dot(pv.df_mv[j], g);
+      // |grad_j rho_i|^2 m_i / m_j: m_i = m_j for the mass density of one phase (the 2015 paper's sum).
+      // Without a branch on the kind: next to a wall it would be taken at random.
+      const bool fluid = pv.is_fluid(j);
+      const Real ratio = number ? mi / pv.m[j] : Real(1);
+      sq += fluid ? norm2(mg) * ratio : Real(0);
+      gwall += mg * (fluid ? Real(0) : Real(1));
+    }
+    // k_i's own effect on D rho_i / Dt: its kick is -dt k_i (G_i + B_i) with the walls mirrored (B_i their
+    // part of G_i), -dt k_i G_i without; so the diagonal is (G_i + B_i) . G_i + sq, or |G_i|^2 + sq. Next
+    // to a wall G_i is small and (G_i + B_i) . G_i may be negative: then sq alone, a larger diagonal than
+    // the true one (a shorter Jacobi step, never an overshoot).
+    const Real denom = (mirror ? std::max(dot(grad + gwall, grad), Real(0)) : norm2(grad)) + sq;
+    pv.rho[i] = rho;
+    pv.vol[i] = pv.m[i] / rho;
+    pv.df_alpha[i] = denom > denom_floor ? Real(1) / denom : Real(0);
+    pv.df_gsum[i] = grad;
+    pv.df_gwall[i] = gwall;
+    pv.prho2[i] = warm;
+    if (fold_warm) warm_divergence.apply(pv, i, dot(pv.v[i], grad) - mv_sum);
+  }
+};
+
+template <int Dim, class Real, class Kernel>
+struct DfsphSourcePass {
+  ParticleView<Dim, Real> pv;
+  Kernel w;
+  DfsphSourceRule<Real> rule;
+  bool number;  // number density (DensityFormulation::Number)
+
+  CELLSPH_HD Real operator()(std::size_t i) const {
+    return rule.apply(pv, i, number ? dfsph_density_rate(pv, i, number) : dfsph_density_rate_factored(pv, i));
   }
 };
 
@@ -280,17 +303,17 @@ struct DfsphNonPressurePass {
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
-      const Real r = norm(xij);
+      const Real r2 = norm2(xij);
       const V g = xij * pv.df_grad[it - pv.within];
       if (pv.is_fluid(j)) {
-        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
+        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
         continue;
       }
       const Real wb = dfsph_weight(pv, number, i, j);
-      if (no_slip) f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r, vol_i, wb / rhoi, mui, mui, eta2);
+      if (no_slip) f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, wb / rhoi, mui, mui, eta2);
       // The pressure force's wall term -m_i w_b (p_b / rho_i^2) grad W_ib for the part of p_b beyond p_i
-      // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i g . (x_b - x_i).
-      if (hydrostatic) f -= g * (pv.m[i] * wb * dot(gravity, V(pv.x[j] - xi)) / rhoi);
+      // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i g . (x_b - x_i) = -rho_i g . x_ib.
+      if (hydrostatic) f += g * (pv.m[i] * wb * dot(gravity, xij) / rhoi);
     }
     pv.f[i] = f;
   }
@@ -322,20 +345,28 @@ struct DfsphSolveResult {
   double error = 0;  // relative (not percent)
 };
 
+// The warm start's rule: half the last step's k, as SPlisHSPlasH (the full sum, measured, set the
+// hydrostatic column and the dam break ringing).
+template <class Real>
+DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool warm_start,
+                                      std::uint32_t min_neighbors) {
+  return {dt, density, true, Real(warm_start ? 0.5 : 0.0), acc, min_neighbors};
+}
+
 // One solve (density or divergence): warm start, then sweeps until the average error is at most eta
-// (relative) after at least min_it sweeps, or max_it sweeps were made.
+// (relative) after at least min_it sweeps, or max_it sweeps were made. warm_k_set: the warm start's k are
+// written already (the density pass's fold_warm).
 template <int Dim, class Real, class Kernel, class Set>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
-                             std::uint32_t min_neighbors, bool number, bool mirror) {
+                             std::uint32_t min_neighbors, bool number, bool mirror, bool warm_k_set = false) {
   const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number, mirror};
-  // Half the last step's k, as SPlisHSPlasH: the full sum (measured) set the hydrostatic column and the
-  // dam break ringing.
-  run_pass(set, DfsphSourcePass<Dim, Real, Kernel>{pv, w, dt, density, true, Real(warm_start ? 0.5 : 0.0),
-                                                   acc, min_neighbors, number});
+  if (!warm_k_set)
+    run_pass(set, DfsphSourcePass<Dim, Real, Kernel>{
+                      pv, w, dfsph_warm_rule(dt, density, acc, warm_start, min_neighbors), number});
   if (warm_start) run_pass(set, kick);
-  const DfsphSourcePass<Dim, Real, Kernel> source{pv,    w, dt, density, false, Real(0), acc, min_neighbors,
-                                                  number};
+  const DfsphSourcePass<Dim, Real, Kernel> source{
+      pv, w, DfsphSourceRule<Real>{dt, density, false, Real(0), acc, min_neighbors}, number};
   const double n = static_cast<double>(std::max<std::size_t>(set_size(set), 1));
   DfsphSolveResult r;
   for (;;) {
@@ -383,8 +414,11 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     using K = std::remove_cvref_t<decltype(w)>;
     Stopwatch sw;
     const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
-    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{pv, w, denom_floor, number, mirror});
+    // The mass density's divergence warm start rides along the density pass (its rule does not read dt).
     if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
+    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{
+                        pv, w, denom_floor, number, mirror, !number,
+                        dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start, min_neighbors)});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
       dt = cfg.time.dt;
@@ -415,7 +449,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     };
     const DfsphSolveResult div =
         dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
-                    cfg.dfsph.warm_start, min_neighbors, number, mirror);
+                    cfg.dfsph.warm_start, min_neighbors, number, mirror, !number);
     check(div, eta_divergence, "divergence-free");
     st.ms_divergence += sw.ms();
     sw.reset();

@@ -57,7 +57,8 @@ struct WcsphForcesPass {
       // and the wall's no-slip velocity, the artificial one the wall's own (its prescribed velocity).
       fp += symmetric_pressure_force(g, mi, pv.m[j], pv.prho2[i], pv.prho2[j]);
       if (no_slip && laminar)
-        fnp += morris_viscosity_force(V(vel_i - pv.wall_v[j]), g, xij, r, vol_i, pv.vol[j], mui, mui, eta2);
+        fnp +=
+            morris_viscosity_force(V(vel_i - pv.wall_v[j]), g, xij, r * r, vol_i, pv.vol[j], mui, mui, eta2);
       if (av_walls && alpha_c0_h > 0)
         fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, pv.rho[j],
                                           alpha_c0_h, eta2);
@@ -68,7 +69,8 @@ struct WcsphForcesPass {
       const Real pb = akinci2012_wall_pressure(pi, rhoi, gravity, xij, clamp_negative);
       fp += boundary_pressure_force(g, mi, rhoi, pi, pb, pv.m[j]);
       if (no_slip && laminar)
-        fnp += morris_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
+        fnp +=
+            morris_viscosity_force(V(vel_i - pv.v[j]), g, xij, r * r, vol_i, pv.m[j] / rhoi, mui, mui, eta2);
       if (av_walls && alpha_c0_h > 0)
         fnp += artificial_viscosity_force(V(vel_i - pv.v[j]), g, xij, r, mi, pv.m[j], rhoi, rhoi, alpha_c0_h,
                                           eta2);
@@ -94,7 +96,7 @@ struct WcsphForcesPass {
       if (pv.is_fluid(j)) {
         const V vij = vel_i - pv.v[j];
         if (laminar || pv.mu[j] > 0)
-          fnp += morris_viscosity_force(vij, g, xij, r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
+          fnp += morris_viscosity_force(vij, g, xij, r * r, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
         if (alpha_c0_h > 0)
           fnp += artificial_viscosity_force(vij, g, xij, r, mi, pv.m[j], rhoi, pv.rho[j], alpha_c0_h, eta2);
         fp += symmetric_pressure_force(g, mi, pv.m[j], prho2_i, pv.prho2[j]);
