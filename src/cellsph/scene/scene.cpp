@@ -531,8 +531,9 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     d.max_iterations = static_cast<int>(dr.integer("max_iterations", d.max_iterations, 1, 100000));
     d.warm_start = dr.boolean("warm_start", d.warm_start);
     const std::string wall_pressure = dr.choice("wall_pressure", "zero", {"zero", "mirrored", "hydrostatic"});
-    d.mirror_walls = wall_pressure != "zero";
-    d.hydrostatic_walls = wall_pressure == "hydrostatic";
+    d.wall_pressure = wall_pressure == "zero"       ? DfsphWallPressure::Zero
+                      : wall_pressure == "mirrored" ? DfsphWallPressure::Mirrored
+                                                    : DfsphWallPressure::Hydrostatic;
     if (d.min_iterations > d.max_iterations)
       dr.fail("min_iterations", "value " + std::to_string(d.min_iterations) + " exceeds max_iterations " +
                                     std::to_string(d.max_iterations));

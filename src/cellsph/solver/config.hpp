@@ -59,6 +59,13 @@ enum class DensityDiffusion {
   Fourtakas,  // Fourtakas et al. 2019: the same on rho minus its hydrostatic part
 };
 
+// A wall particle's pressure in DFSPH's pressure force (SolverConfig::Dfsph::wall_pressure).
+enum class DfsphWallPressure {
+  Zero,         // "zero": 0, Akinci 2012 as SPlisHSPlasH
+  Mirrored,     // "mirrored": the fluid particle's own
+  Hydrostatic,  // "hydrostatic": the fluid particle's own plus rho_i g . (x_b - x_i)
+};
+
 enum class TimeStepping {
   Fixed,    // dt = time.dt every step (the paper's test)
   Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
@@ -219,8 +226,8 @@ struct SolverConfig {
     // row ~6% over rho0 g d); or that plus the hydrostatic rise to the wall particle, rho_i g . (x_b - x_i)
     // ("hydrostatic", Adami's extrapolation for walls at rest, applied once a step with the non-pressure
     // forces).
-    bool mirror_walls = false;
-    bool hydrostatic_walls = false;  // only with mirror_walls
+    DfsphWallPressure wall_pressure = DfsphWallPressure::Zero;
+    bool mirror_walls() const { return wall_pressure != DfsphWallPressure::Zero; }
   } dfsph{};
 
   SearchOptions search{};

@@ -58,8 +58,9 @@ struct ColumnRun {
 ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool hydrostatic = false) {
   const double s = 0.02, W = 0.4, H = 0.4, rho0 = 1000, g = 9.81;
   auto cfg = dfsph_water<2, double>(s, 5.0, dt_max);
-  cfg.dfsph.mirror_walls = mirror;
-  cfg.dfsph.hydrostatic_walls = hydrostatic;
+  cfg.dfsph.wall_pressure = hydrostatic ? DfsphWallPressure::Hydrostatic
+                            : mirror    ? DfsphWallPressure::Mirrored
+                                        : DfsphWallPressure::Zero;
   cfg.domain_set = true;
   cfg.domain_lo = V2{{-0.1, -0.1}};
   cfg.domain_hi = V2{{W + 0.1, 2 * H}};
@@ -193,8 +194,7 @@ class DfsphWalls : public ::testing::TestWithParam<int> {};  // 0 zero, 1 mirror
 
 TEST_P(DfsphWalls, DamBreakLosesNoParticleThroughTheWalls) {
   auto d = dam_break(Method::CellIndex);
-  d.cfg.dfsph.mirror_walls = GetParam() > 0;
-  d.cfg.dfsph.hydrostatic_walls = GetParam() == 2;
+  d.cfg.dfsph.wall_pressure = static_cast<DfsphWallPressure>(GetParam());
   Simulation<2, double> sim(d.cfg, d.particles);
   double dt_min = 1, dt_max = 0, vmax = 0;
   while (sim.time() < 1.0) {
@@ -280,7 +280,7 @@ TEST(Dfsph, BitIdenticalAcrossRunsThreadsAndMethods) {
   StepTimings timings;
   auto run = [&timings](Method method, int threads, double skin = -1, bool mirror = false) {
     auto d = dam_break(method);
-    d.cfg.dfsph.mirror_walls = mirror;
+    if (mirror) d.cfg.dfsph.wall_pressure = DfsphWallPressure::Mirrored;
     if (skin >= 0) d.cfg.verlet_skin = skin;
     ScopedThreads t(threads);
     Simulation<2, double> sim(d.cfg, d.particles);
@@ -344,8 +344,7 @@ TEST(Dfsph, SmallColumn2DFloat) {
 // on the device resumes on the CPU as if uninterrupted.
 TEST_P(DfsphWalls, HostDeviceIsBitIdenticalToTheCpuAndResumesAcrossBackends) {
   auto d = dam_break(Method::CellIndex);
-  d.cfg.dfsph.mirror_walls = GetParam() > 0;
-  d.cfg.dfsph.hydrostatic_walls = GetParam() == 2;
+  d.cfg.dfsph.wall_pressure = static_cast<DfsphWallPressure>(GetParam());
   Simulation<2, double> cpu(d.cfg, d.particles);
   Simulation<2, double> dev(d.cfg, d.particles);
   dev.use_backend(Backend::HostDevice);

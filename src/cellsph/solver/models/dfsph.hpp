@@ -407,7 +407,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
   const double eta_density = double(cfg.dfsph.max_density_error) / 100;
   const double eta_divergence = double(cfg.dfsph.max_divergence_error) / 100;
   const bool number = cfg.density == DensityFormulation::Number;
-  const bool mirror = cfg.dfsph.mirror_walls;
+  const bool mirror = cfg.dfsph.mirror_walls();
 
   Real dt = 0;
   with_kernel<Dim, Real>(cfg.density_kernel, h, [&](const auto w) {
@@ -454,9 +454,9 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     st.ms_divergence += sw.ms();
     sw.reset();
 
-    run_pass(fluid,
-             DfsphNonPressurePass<Dim, Real, K>{pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2),
-                                                cfg.no_slip, number, mirror && cfg.dfsph.hydrostatic_walls});
+    run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{
+                        pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2), cfg.no_slip, number,
+                        cfg.dfsph.wall_pressure == DfsphWallPressure::Hydrostatic});
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
     st.ms_nonpressure += sw.ms();
     sw.reset();
