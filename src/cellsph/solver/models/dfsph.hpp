@@ -182,7 +182,7 @@ struct DfsphDensityFactorPass {
   Kernel w;
   Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
   bool number;       // number density (DensityFormulation::Number)
-  bool mirror;       // walls' k mirrored from the fluid particle's (SolverConfig::Dfsph::mirror_walls)
+  bool mirror;       // walls' k mirrored from the fluid particle's (SolverConfig::Dfsph::mirror_walls())
   bool fold_warm;    // also the divergence solve's warm start, by warm_divergence (mass density only)
   DfsphSourceRule<Real> warm_divergence;
 
