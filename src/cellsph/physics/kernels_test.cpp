@@ -169,15 +169,22 @@ TEST(Kernels, FloatMatchesDouble) {
 // gradW_factor is the scalar of the gradient: r * gradW_factor(r) has gradW(r)'s bits for every kernel,
 // dimension and precision inside the support, and is zero beyond it (models/dfsph.hpp stores the scalar and
 // rebuilds the vector, and relies on it for results identical to recomputing gradW).
-template <int Dim, class Real>
-void check_gradient_factor() {
-  std::uint64_t state = 12345;
-  auto uniform = [&state] {  // a fixed LCG: the same samples on every platform
+// Uniform samples in [0, 1) from a fixed LCG: the same samples on every platform.
+struct Lcg {
+  std::uint64_t state;
+  double operator()() {
     state = state * 6364136223846793005ull + 1442695040888963407ull;
     return double(state >> 11) / double(1ull << 53);
-  };
-  for (const KernelKind kind : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity,
-                                KernelKind::CubicSpline, KernelKind::WendlandC2}) {
+  }
+};
+
+constexpr KernelKind kAllKernels[] = {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity,
+                                      KernelKind::CubicSpline, KernelKind::WendlandC2};
+
+template <int Dim, class Real>
+void check_gradient_factor() {
+  Lcg uniform{12345};
+  for (const KernelKind kind : kAllKernels) {
     with_kernel<Dim, Real>(kind, Real(kH), [&](const auto w) {
       for (int k = 0; k < 2000; ++k) {
         Vec<Dim, Real> rv;
@@ -209,13 +216,8 @@ TEST(Kernels, GradientFactorRebuildsTheGradientsBits) {
 // random points, at r = 0, at the cubic spline's seam q = 1/2 and at the support's edge.
 template <int Dim, class Real>
 void check_value_and_factor() {
-  std::uint64_t state = 777;
-  auto uniform = [&state] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return double(state >> 11) / double(1ull << 53);
-  };
-  for (const KernelKind kind : {KernelKind::Poly6, KernelKind::Spiky, KernelKind::Viscosity,
-                                KernelKind::CubicSpline, KernelKind::WendlandC2}) {
+  Lcg uniform{777};
+  for (const KernelKind kind : kAllKernels) {
     with_kernel<Dim, Real>(kind, Real(kH), [&](const auto w) {
       for (int k = 0; k < 2004; ++k) {
         Vec<Dim, Real> rv{};
