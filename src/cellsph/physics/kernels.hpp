@@ -187,20 +187,22 @@ struct CubicSplineKernel {
     sigma = Dim == 3 ? Real(8) / (detail::kPi<Real> * h * h * h)
                      : Real(40) / (Real(7) * detail::kPi<Real> * h * h);
   }
+  // The two pieces of W and W': for q = r / h up to 1/2, and in d = 1 - q beyond (W, dW and
+  // value_and_factor take them from here).
+  CELLSPH_HD Real w_inner(Real q) const { return sigma * (Real(6) * (q * q * q - q * q) + 1); }
+  CELLSPH_HD Real w_outer(Real d) const { return sigma * Real(2) * d * d * d; }
+  CELLSPH_HD Real dw_inner(Real q) const { return sigma * inv_h * Real(6) * (Real(3) * q * q - Real(2) * q); }
+  CELLSPH_HD Real dw_outer(Real d) const { return sigma * inv_h * Real(-6) * d * d; }
   CELLSPH_HD Real W(Real r) const {
     const Real q = r * inv_h;
     if (q > 1) return 0;
-    if (q <= Real(0.5)) return sigma * (Real(6) * (q * q * q - q * q) + 1);
-    const Real d = 1 - q;
-    return sigma * Real(2) * d * d * d;
+    return q <= Real(0.5) ? w_inner(q) : w_outer(1 - q);
   }
   CELLSPH_HD Real W2(Real r2) const { return W(std::sqrt(r2)); }
   CELLSPH_HD Real dW(Real r) const {
     const Real q = r * inv_h;
     if (q > 1) return 0;
-    if (q <= Real(0.5)) return sigma * inv_h * Real(6) * (Real(3) * q * q - Real(2) * q);
-    const Real d = 1 - q;
-    return sigma * inv_h * Real(-6) * d * d;
+    return q <= Real(0.5) ? dw_inner(q) : dw_outer(1 - q);
   }
   CELLSPH_HD Vec<Dim, Real> gradW(const Vec<Dim, Real>& rv) const {
     const Real r = norm(rv);
@@ -217,9 +219,8 @@ struct CubicSplineKernel {
     const Real q = r * inv_h;
     const Real d = 1 - q;
     const bool inner = q <= Real(0.5), inside = !(q > 1), positive = r > Real(0);
-    const Real w = inner ? sigma * (Real(6) * (q * q * q - q * q) + 1) : sigma * Real(2) * d * d * d;
-    const Real dw =
-        inner ? sigma * inv_h * Real(6) * (Real(3) * q * q - Real(2) * q) : sigma * inv_h * Real(-6) * d * d;
+    const Real w = inner ? w_inner(q) : w_outer(d);
+    const Real dw = inner ? dw_inner(q) : dw_outer(d);
     const Real f = dw / (positive ? r : Real(1));
     return {inside ? w : Real(0), inside && positive ? f : Real(0)};
   }
@@ -243,11 +244,19 @@ struct WendlandC2Kernel {
     sigma = Dim == 3 ? Real(21) / (Real(2) * detail::kPi<Real> * h * h * h)
                      : Real(7) / (detail::kPi<Real> * h * h);
   }
-  CELLSPH_HD Real W(Real r) const {
-    const Real q = r * inv_h;
-    if (q > 1) return 0;
+  // W and W'(r)/r for q = r / h <= 1 (W, gradW, gradW_factor and value_and_factor take them from here).
+  // W'(r)/r = -20 sigma (1-q)^3 / h^2 is regular at r = 0: no division by r.
+  CELLSPH_HD Real w_of(Real q) const {
     const Real d = 1 - q, d2 = d * d;
     return sigma * d2 * d2 * (1 + Real(4) * q);
+  }
+  CELLSPH_HD Real factor_of(Real q) const {
+    const Real d = 1 - q;
+    return Real(-20) * sigma * inv_h * inv_h * d * d * d;
+  }
+  CELLSPH_HD Real W(Real r) const {
+    const Real q = r * inv_h;
+    return q > 1 ? Real(0) : w_of(q);
   }
   CELLSPH_HD Real W2(Real r2) const { return W(std::sqrt(r2)); }
   CELLSPH_HD Real dW(Real r) const {
@@ -257,26 +266,18 @@ struct WendlandC2Kernel {
     return Real(-20) * sigma * inv_h * q * d * d * d;
   }
   CELLSPH_HD Vec<Dim, Real> gradW(const Vec<Dim, Real>& rv) const {
-    // W'(r)/r = -20 sigma (1-q)^3 / h^2 is regular at r = 0: no division by r.
-    const Real r = norm(rv);
-    const Real q = r * inv_h;
-    if (q > 1) return Vec<Dim, Real>{};
-    const Real d = 1 - q;
-    return rv * (Real(-20) * sigma * inv_h * inv_h * d * d * d);
+    const Real q = norm(rv) * inv_h;
+    return q > 1 ? Vec<Dim, Real>{} : rv * factor_of(q);
   }
   CELLSPH_HD Real gradW_factor(const Vec<Dim, Real>& rv) const {
-    const Real r = norm(rv);
-    const Real q = r * inv_h;
-    if (q > 1) return 0;
-    const Real d = 1 - q;
-    return Real(-20) * sigma * inv_h * inv_h * d * d * d;
+    const Real q = norm(rv) * inv_h;
+    return q > 1 ? Real(0) : factor_of(q);
   }
   // W2(r2) and gradW_factor with their bits, from one square root (as CubicSplineKernel's).
   CELLSPH_HD KernelValueAndFactor<Real> value_and_factor(Real r2) const {
     const Real q = std::sqrt(r2) * inv_h;
-    const Real d = 1 - q, d2 = d * d;
     if (q > 1) return {Real(0), Real(0)};
-    return {sigma * d2 * d2 * (1 + Real(4) * q), Real(-20) * sigma * inv_h * inv_h * d * d * d};
+    return {w_of(q), factor_of(q)};
   }
   CELLSPH_HD Real laplacian(Real r) const {
     const Real q = r * inv_h;
