@@ -173,7 +173,7 @@ struct DfsphSourceRule {
 
 // Step 1: density, volume, alpha, and the density solve's warm start k = p / rho^2 of the last step
 // (read before rho is overwritten; p and rho are particle fields, so a checkpoint carries it). For the mass
-// density it also takes the divergence solve's warm-start pass (fold_warm): that pass's rate is
+// density (!number) it also takes the divergence solve's warm-start pass: that pass's rate is
 // v_i . G_i - sum_j (w_j v_j) . grad W_ij with the velocities of the step's start, so its pair sum can ride
 // along this loop (DfsphPairStatePass has written every w_j v_j before), one traversal of the rows less.
 template <int Dim, class Real, class Kernel>
@@ -183,8 +183,7 @@ struct DfsphDensityFactorPass {
   Real denom_floor;  // below this the particle has too few neighbours for a pressure: alpha = 0
   bool number;       // number density (DensityFormulation::Number)
   bool mirror;       // walls' k mirrored from the fluid particle's (SolverConfig::Dfsph::mirror_walls())
-  bool fold_warm;    // also the divergence solve's warm start, by warm_divergence (mass density only)
-  DfsphSourceRule<Real> warm_divergence;
+  DfsphSourceRule<Real> warm_divergence;  // the divergence solve's warm start (mass density)
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -209,7 +208,7 @@ struct DfsphDensityFactorPass {
       const V g = dfsph_grad(pv, xi, it);  // = w.gradW(x_ij), bit for bit
       const V mg = g * wj;
       grad += mg;
-      if (fold_warm) mv_sum += dot(pv.df_mv[j], g);
+      if (!number) mv_sum += dot(pv.df_mv[j], g);
       // |grad_j rho_i|^2 m_i / m_j: m_i = m_j for the mass density of one phase (the 2015 paper's sum).
       // Without a branch on the kind: next to a wall it would be taken at random.
       const bool fluid = pv.is_fluid(j);
@@ -228,7 +227,7 @@ struct DfsphDensityFactorPass {
     pv.df_gsum[i] = grad;
     pv.df_gwall[i] = gwall;
     pv.prho2[i] = warm;
-    if (fold_warm) warm_divergence.apply(pv, i, dot(pv.v[i], grad) - mv_sum);
+    if (!number) warm_divergence.apply(pv, i, dot(pv.v[i], grad) - mv_sum);
   }
 };
 
@@ -355,7 +354,7 @@ DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool war
 
 // One solve (density or divergence): warm start, then sweeps until the average error is at most eta
 // (relative) after at least min_it sweeps, or max_it sweeps were made. warm_k_set: the warm start's k are
-// written already (the density pass's fold_warm).
+// written already (the density pass writes the mass density's divergence warm start).
 template <int Dim, class Real, class Kernel, class Set>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
@@ -417,7 +416,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     // The mass density's divergence warm start rides along the density pass (its rule does not read dt).
     if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
     run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{
-                        pv, w, denom_floor, number, mirror, !number,
+                        pv, w, denom_floor, number, mirror,
                         dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start, min_neighbors)});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
