@@ -92,21 +92,28 @@ TEST(SceneShapes, ContainerMeshHoldsTheFluidHalfASpacingInside) {
 }
 
 // Still water in the glass: data/meshes/cylinder.stl scaled to radius 0.2 m and height 0.4 m, given as an
-// STL container, water 0.25 m deep at spacing 0.025 m (16 particles across), the hydrostatic tank's model
-// (WCSPH, c = 10 sqrt(2 g H), continuity density with Fourtakas's diffusion, free-slip Akinci walls, alpha
-// 0.01; docs/scenes.md, hydrostatic-tank). 10^4 steps (about 6.8 s): no fluid particle leaves the glass, and
-// the pressure at three heights on the axis, averaged over the last 2000 steps, is rho0 g (level - z) within
-// 2% of rho0 g level, with the level a probe measures on the axis at the same times (the water settles
-// about 0.03 m lower than it was filled: the fluid starts half a spacing inside the curved wall and spreads
-// up to the wall particles, which the lattice puts anywhere in the first spacing outside the surface).
-// The reference is the hydrostatic law on the measured level, not the solver's own figure.
-TEST(SceneShapes, ContainerMeshHoldsStillWaterForTenThousandSteps) {
+// STL container, filled 0.25 m deep, the hydrostatic tank's model (WCSPH, c = 10 sqrt(2 g H), continuity
+// density with Fourtakas's diffusion, free-slip Akinci walls, alpha 0.01; docs/scenes.md,
+// hydrostatic-tank), run for `steps` steps on 2 threads. Returns the fluid particles that left the glass,
+// and the pressure at three heights on the axis and the level there, averaged over the steps after
+// `average_from` (every 20th step). The water settles lower than it was filled (the fluid starts half a
+// spacing inside the curved wall and spreads up to the wall particles, which the lattice puts anywhere in
+// the first spacing outside the surface), so the reference is the hydrostatic law on the level a probe
+// measures at the same times, not the solver's own figure.
+struct StillGlass {
+  std::size_t fluid = 0, outside = 0;
+  double level = 0, time = 0;
+  std::vector<double> pressure;  // at kGlassHeights
+};
+const std::vector<double> kGlassHeights{0.04, 0.08, 0.12};
+
+StillGlass still_glass(double spacing, int steps, int average_from) {
   TempDir dir;
   fs::copy_file(kMeshes / "cylinder.stl", dir.path / "glass.stl");
   const double R = 0.2, H = 0.25, g = 9.81, rho0 = 1000, c = 10 * std::sqrt(2 * g * H);
-  auto j = nlohmann::json::parse(R"({"dimension": 3, "precision": "double", "spacing": 0.025,
+  auto j = nlohmann::json::parse(R"({"dimension": 3, "precision": "double",
       "phases": [{"name": "water", "rest_density": 1000, "viscosity": 0.001}],
-      "solver": {"model": "wcsph", "support": 0.05, "density_kernel": "cubic", "pressure_kernel": "cubic",
+      "solver": {"model": "wcsph", "density_kernel": "cubic", "pressure_kernel": "cubic",
                  "eos": {"kind": "ratio", "clamp_negative": true}, "gravity": [0, 0, -9.81],
                  "artificial_viscosity": {"alpha": 0.01}, "density": "continuity",
                  "density_diffusion": {"kind": "fourtakas", "delta": 0.1}},
@@ -115,19 +122,20 @@ TEST(SceneShapes, ContainerMeshHoldsStillWaterForTenThousandSteps) {
       "fluids": [{"min": [-0.25, -0.25, 0], "max": [0.25, 0.25, 0.25]}],
       "boundary": {"slip": "free", "model": "akinci",
                    "obstacles": [{"mesh": "glass.stl", "scale": 0.4, "inside": true, "layers": 2}]}})");
+  j["spacing"] = spacing;
+  j["solver"]["support"] = 2 * spacing;
   j["solver"]["eos"]["stiffness"] = rho0 * c * c;
   std::ofstream(dir.path / "glass.json") << j.dump();
   auto scene = load_file<3>(dir.path / "glass.json");
-  std::size_t fluid = 0;
-  for (const auto k : scene.particles.kind) fluid += k == static_cast<std::uint8_t>(ParticleKind::Fluid);
+  StillGlass out;
+  for (const auto k : scene.particles.kind) out.fluid += k == static_cast<std::uint8_t>(ParticleKind::Fluid);
   ScopedThreads two(2);
   Simulation<3, double> sim(scene.solver, scene.particles);
-  const std::vector<double> z{0.04, 0.08, 0.12};
   std::vector<Probe> probes;
-  for (std::size_t k = 0; k < z.size(); ++k) {
+  for (std::size_t k = 0; k < kGlassHeights.size(); ++k) {
     Probe pr;
     pr.name = std::vector<std::string>{"lower", "middle", "upper"}[k];
-    pr.at = {0, 0, z[k]};
+    pr.at = {0, 0, kGlassHeights[k]};
     probes.push_back(pr);
   }
   Probe level;
@@ -135,36 +143,64 @@ TEST(SceneShapes, ContainerMeshHoldsStillWaterForTenThousandSteps) {
   level.kind = ProbeKind::Level;
   level.at = {0, 0, 0};
   probes.push_back(level);
-  const ProbeSampler<3, double> sampler(probes, KernelKind::CubicSpline, 0.05, 0.025);
+  const ProbeSampler<3, double> sampler(probes, KernelKind::CubicSpline, 2 * spacing, spacing);
   std::vector<double> sum(probes.size(), 0.0);
   int samples = 0;
-  for (int step = 1; step <= 10000; ++step) {
+  for (int step = 1; step <= steps; ++step) {
     sim.step();  // a particle leaving the domain or a non-finite value throws SimulationError
-    if (step > 8000 && step % 20 == 0) {
+    if (step > average_from && step % 20 == 0) {
       const auto v = sampler.sample(sim.particles());
       for (std::size_t k = 0; k < probes.size(); ++k) sum[k] += v[k];
       ++samples;
     }
   }
   const auto& p = sim.particles();
-  std::size_t outside = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
     if (p.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) &&
         (std::hypot(p.x[i][0], p.x[i][1]) > R || p.x[i][2] < 0))
-      ++outside;
-  EXPECT_EQ(outside, 0u) << "of " << fluid << " fluid particles after " << sim.time() << " s";
-  const double surface = sum[3] / samples;
-  EXPECT_GT(surface, 0.8 * H) << "the water level on the axis";
-  EXPECT_LT(surface, H);
-  for (std::size_t k = 0; k < z.size(); ++k) {
-    const double mean = sum[k] / samples, ref = rho0 * g * (surface - z[k]);
-    std::cout << "[glass] z " << z[k] << " m: pressure " << mean << " Pa, rho0 g (level - z) " << ref
-              << " Pa (level " << surface << " m), error " << 100 * (mean - ref) / (rho0 * g * surface)
-              << "% of rho0 g level (t = " << sim.time() << " s, " << fluid << " fluid particles)\n";
-    // The issue's bound, 2%, at the middle and upper probes (measured -1.6% and -0.1%); the lower one,
-    // 1.6 spacings above the floor (within one support of the wall, whose particles the Shepard sum
-    // leaves out), measured -2.7%: it misses the 2% and is held to 3% (docs/scenes.md, "Shapes").
-    EXPECT_NEAR(mean, ref, (k == 0 ? 0.03 : 0.02) * rho0 * g * surface) << "z " << z[k];
+      ++out.outside;
+  out.level = sum.back() / samples;
+  for (std::size_t k = 0; k < kGlassHeights.size(); ++k) {
+    out.pressure.push_back(sum[k] / samples);
+    const double ref = rho0 * g * (out.level - kGlassHeights[k]);
+    std::cout << "[glass " << spacing << " m] z " << kGlassHeights[k] << " m: pressure " << out.pressure[k]
+              << " Pa, rho0 g (level - z) " << ref << " Pa (level " << out.level << " m), error "
+              << 100 * (out.pressure[k] - ref) / (rho0 * g * out.level)
+              << "% of rho0 g level (t = " << sim.time() << " s, " << out.fluid << " fluid particles)\n";
+  }
+  out.time = sim.time();
+  return out;
+}
+
+// At spacing 0.025 m (16 particles across, 1720 of them), 10^4 steps (about 6.8 s): no fluid particle
+// leaves the glass, and the pressure averaged over the last 2000 steps is within 2% of rho0 g level at the
+// middle and upper probes (measured -1.6% and -0.1%). The lower one, 1.6 spacings above the floor,
+// measured -2.7% and is held to 3% here: at this resolution the settled particles hold part of the
+// column's weight on the wall (the gradient between the probes is 7% below rho0 g; walls moved onto
+// smooth layers instead of lattice sites measured the same). The issue's 2% at every probe is checked at
+// twice the resolution below.
+TEST(SceneShapes, ContainerMeshHoldsStillWaterForTenThousandSteps) {
+  const auto r = still_glass(0.025, 10000, 8000);
+  EXPECT_EQ(r.outside, 0u) << "of " << r.fluid << " fluid particles after " << r.time << " s";
+  EXPECT_GT(r.level, 0.8 * 0.25) << "the water level on the axis";
+  EXPECT_LT(r.level, 0.25);
+  for (std::size_t k = 0; k < kGlassHeights.size(); ++k) {
+    const double unit = 1000 * 9.81 * r.level, ref = unit * (1 - kGlassHeights[k] / r.level);
+    EXPECT_NEAR(r.pressure[k], ref, (k == 0 ? 0.03 : 0.02) * unit) << "z " << kGlassHeights[k];
+  }
+}
+
+// The same glass at spacing 0.0125 m (32 particles across, 14,800 of them), settled for 1.5 s and averaged
+// over the next second (7400 steps of about 0.34 ms): the pressure at all three heights within the issue's
+// 2% of rho0 g level (the CLI's probes measured +0.3%, +1.2%, +0.5% over 1.5-3 s; -1.0%, -0.7%, -0.6% over
+// 5.4-6.8 s, docs/scenes.md).
+TEST(SceneShapes, ContainerMeshHydrostaticPressureWithinTwoPercent) {
+  const auto r = still_glass(0.0125, 7400, 4430);
+  EXPECT_EQ(r.outside, 0u) << "of " << r.fluid << " fluid particles after " << r.time << " s";
+  EXPECT_GT(r.time, 2.4);
+  for (std::size_t k = 0; k < kGlassHeights.size(); ++k) {
+    const double unit = 1000 * 9.81 * r.level, ref = unit * (1 - kGlassHeights[k] / r.level);
+    EXPECT_NEAR(r.pressure[k], ref, 0.02 * unit) << "z " << kGlassHeights[k];
   }
 }
 
