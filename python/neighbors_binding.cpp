@@ -22,11 +22,12 @@ namespace {
 
 // A NumPy array that owns `v` (moved to the heap; freed when the array is), viewed as elements of type T
 // (same size: the uint64 offsets are shown as int64, all far below 2^63).
-template <class T, class U>
-py::array owning_array(std::vector<U>&& v) {
+template <class T, class U, class A>
+py::array owning_array(std::vector<U, A>&& v) {
   static_assert(sizeof(T) == sizeof(U));
-  auto* heap = new std::vector<U>(std::move(v));
-  py::capsule owner(heap, [](void* p) { delete static_cast<std::vector<U>*>(p); });
+  using Vector = std::vector<U, A>;
+  auto* heap = new Vector(std::move(v));
+  py::capsule owner(heap, [](void* p) { delete static_cast<Vector*>(p); });
   const auto n = static_cast<py::ssize_t>(heap->size());
   return py::array(py::dtype::of<T>(), {n}, {static_cast<py::ssize_t>(sizeof(T))}, heap->data(), owner);
 }

@@ -75,7 +75,7 @@ void expect_exact(const Points<Dim, Real>& x, const std::vector<Real>& h, const 
   const NeighborList ref = all_pairs<Dim, Real>(x, h);
   for (int H : {1, 2, 3})
     for (bool wide : {false, true}) {
-      std::vector<std::uint32_t> unsorted_one_thread;
+      FreshVector<std::uint32_t> unsorted_one_thread;
       for (int threads : {1, 2}) {
         SCOPED_TRACE(what + " H=" + std::to_string(H) + (wide ? " wide" : " packed") +
                      " threads=" + std::to_string(threads));

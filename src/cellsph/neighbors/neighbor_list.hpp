@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "cellsph/core/fresh_memory.hpp"
+
 namespace cellsph {
 
 enum class Method { AllPairs, SpatialHash, CellIndex, SortedGrid, KdTree };
@@ -44,9 +46,11 @@ struct SearchStats {
 
 // Compressed sparse rows: neighbours of i are indices[offsets[i] .. offsets[i+1]).
 // Each row is sorted ascending, so the output does not depend on the method or thread count.
+// Both arrays are FreshVectors: their resize() leaves new entries unwritten (every search writes each
+// one), so a fresh list pays no one-thread zero fill before the search fills it.
 struct NeighborList {
-  std::vector<std::uint64_t> offsets;  // n + 1 entries
-  std::vector<std::uint32_t> indices;
+  FreshVector<std::uint64_t> offsets;  // n + 1 entries
+  FreshVector<std::uint32_t> indices;
 
   [[nodiscard]] std::size_t size() const { return offsets.empty() ? 0 : offsets.size() - 1; }
   [[nodiscard]] std::size_t count(std::size_t i) const { return offsets[i + 1] - offsets[i]; }
