@@ -63,7 +63,7 @@ enum class DensityDiffusion {
 enum class DfsphWallPressure {
   Zero,         // "zero": 0, Akinci 2012 as SPlisHSPlasH
   Mirrored,     // "mirrored": the fluid particle's own
-  Hydrostatic,  // "hydrostatic": the fluid particle's own plus rho_i g . (x_b - x_i)
+  Hydrostatic,  // "hydrostatic": the fluid particle's own plus rho_i (g - a_b) . (x_b - x_i)
 };
 
 enum class TimeStepping {
@@ -223,9 +223,9 @@ struct SolverConfig {
     // A wall particle's pressure in the pressure force (`wall_pressure`): 0 ("zero", Akinci 2012 as
     // SPlisHSPlasH: the fluid row next to a wall then carries the column on half the terms, and its
     // pressure is ~1.8x rho0 g d); the fluid particle's own ("mirrored": extrapolated at zeroth order, that
-    // row ~6% over rho0 g d); or that plus the hydrostatic rise to the wall particle, rho_i g . (x_b - x_i)
-    // ("hydrostatic", Adami's extrapolation for walls at rest, applied once a step with the non-pressure
-    // forces).
+    // row ~6% over rho0 g d); or that plus the hydrostatic rise to the wall particle,
+    // rho_i (g - a_b) . (x_b - x_i) ("hydrostatic", Adami's extrapolation, a_b a moving wall's acceleration,
+    // applied once a step with the non-pressure forces).
     DfsphWallPressure wall_pressure = DfsphWallPressure::Zero;
     bool mirror_walls() const { return wall_pressure != DfsphWallPressure::Zero; }
   } dfsph{};

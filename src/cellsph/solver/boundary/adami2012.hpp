@@ -43,7 +43,7 @@ struct Adami2012WallStatePass {
       vsum += pv.v[f] * wwf;
     }
     // A wall particle no fluid particle reaches is read by no force; it keeps rest values.
-    const V g = pv.wall_a ? V(gravity - pv.wall_a[b]) : gravity;  // the wall's frame sees g - a_w
+    const V g = pv.wall_gravity(gravity, b);  // the wall's frame sees g - a_w
     Real pw = wsum > 0 ? (psum + dot(g, rsum)) / wsum : Real(0);
     if (eos.clamp_negative && pw < 0) pw = 0;
     const Real rhow = eos.density(pw, pv.rho0[b]);

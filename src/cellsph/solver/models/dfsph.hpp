@@ -292,7 +292,7 @@ struct DfsphNonPressurePass {
   bool no_slip;
   bool
       number;  // number density: a wall's volume is its weight rho0_i V_b over rho_i, i.e. V_b rho0_i / rho_i
-  bool hydrostatic;  // walls' pressure p_i + rho_i g . (x_b - x_i): its g part here, once a step
+  bool hydrostatic;  // walls' pressure p_i + rho_i (g - a_b) . (x_b - x_i): that part here, once a step
 
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
@@ -311,8 +311,9 @@ struct DfsphNonPressurePass {
       const Real wb = dfsph_weight(pv, number, i, j);
       if (no_slip) f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, wb / rhoi, mui, mui, eta2);
       // The pressure force's wall term -m_i w_b (p_b / rho_i^2) grad W_ib for the part of p_b beyond p_i
-      // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i g . (x_b - x_i) = -rho_i g . x_ib.
-      if (hydrostatic) f += g * (pv.m[i] * wb * dot(gravity, xij) / rhoi);
+      // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i (g - a_b) . (x_b - x_i) = -rho_i (g - a_b) .
+      // x_ib, with a_b a moving wall's acceleration (the wall's frame sees g - a_b, as Adami's walls do).
+      if (hydrostatic) f += g * (pv.m[i] * wb * dot(pv.wall_gravity(gravity, j), xij) / rhoi);
     }
     pv.f[i] = f;
   }
