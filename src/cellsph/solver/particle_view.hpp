@@ -81,8 +81,9 @@ struct ParticleView {
   const PhaseParams<Real>* phases = nullptr;
 
   CELLSPH_HD bool is_fluid(std::size_t j) const { return kind[j] == kFluid; }
-  // The gravity wall particle b's frame sees, g - a_b (a moving wall's or a floating body's acceleration):
-  // what every wall model's hydrostatic extrapolation of the pressure takes. g for walls at rest.
+  // The gravity wall particle b's frame sees, g - a_b (a moving wall's or a floating body's acceleration; g
+  // for walls at rest): what Adami's walls and DFSPH's "hydrostatic" wall pressure extrapolate with.
+  // WCSPH's Akinci walls keep g (a body's noisy a_b fed back into its own pressure: docs/scenes.md).
   CELLSPH_HD V wall_gravity(const V& g, std::size_t b) const { return wall_a ? V(g - wall_a[b]) : g; }
   CELLSPH_HD const std::uint32_t* row_begin(std::size_t i) const { return within + offsets[i]; }
   CELLSPH_HD const std::uint32_t* row_end(std::size_t i) const {
