@@ -2,7 +2,9 @@
 # The CUDA backend's check on a GPU machine, in one command (docs/gpu.md). Builds the CUDA targets there
 # from the sources (cmake/gpu_check.cmake: no Debian library needed), then runs tools/gpu_check.cpp:
 # the device's neighbour rows against the CPU search (exactly equal), dam-break-3d (float) and
-# dam-break-2d, hydrostatic-tank, two-phase, dam-break-2d-dfsph, dam-break-gate (double) for 200 steps on both backends (positions within the stated tolerances), and
+# dam-break-2d, hydrostatic-tank, two-phase, dam-break-2d-dfsph, dam-break-gate (a moving wall), channel-inflow
+# (changing counts), floating-box (double) for 200 steps on both backends (positions within the stated
+# tolerances), and
 # the step benchmark at 10^5 and 10^6 fluid particles (10^7 with GPU_CHECK_SIZES), then compute-sanitizer's
 # memcheck on a short run where the machine allows it. Everything it prints is kept in $OUT/gpu_check.txt
 # (OUT defaults to ./gpu_check_out).
