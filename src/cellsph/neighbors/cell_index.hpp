@@ -17,14 +17,18 @@
 //
 // Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
 // a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
-// (SSE2) at a time and walks the set bits of the hit mask, with no branch per candidate. find_all
+// (SSE2) at a time, in float whatever Real is (a double search keeps its positions in float too,
+// half the bytes), and walks the set bits of the hit mask, with no branch per candidate. find_all
 // counts, keeping every particle's hit masks (blocks of up to 256 candidates in a work buffer, longer
 // ones in a spill per traversal chunk), then fills the rows from them with no second distance test,
 // and sorts each row of up to 64 in registers (sort_network.hpp), up to 96 by rank.
 //
 // Exactness: the neighbour test is distance2(x[i], x[j]) <= h[i]^2 in Real, the same expression as
 // the all-pairs reference; the mask only decides which candidates reach that test, and it is built
-// from exact cell geometry with the inflated cell size of hmask.hpp.
+// from exact cell geometry with the inflated cell size of hmask.hpp. A double search decides in
+// float only the candidates that float cannot misjudge, and tests the rest (those within a thin
+// band around h) in double from the caller's positions (hits64): so build's x must stay alive and
+// unchanged until the last query of that build.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -75,34 +79,27 @@ inline bool cpu_has_avx2() {
   return __builtin_cpu_supports("avx2");
 }
 
-template <int Dim, class Real>
-__attribute__((target("avx2"))) std::uint64_t hits64_avx2(const Real* const* ax, const Real* xi, Real hi2,
-                                                          std::uint32_t m) {
-  std::uint64_t bits = 0;
-  if constexpr (std::is_same_v<Real, float>) {
-    const __m256 h2 = _mm256_set1_ps(hi2);
-    for (std::uint32_t t = 0; t < m; t += 8) {
-      __m256 d = _mm256_sub_ps(_mm256_set1_ps(xi[0]), _mm256_loadu_ps(ax[0] + t));
-      __m256 s2 = _mm256_mul_ps(d, d);
-      for (int k = 1; k < Dim; ++k) {
-        d = _mm256_sub_ps(_mm256_set1_ps(xi[k]), _mm256_loadu_ps(ax[k] + t));
-        s2 = _mm256_add_ps(s2, _mm256_mul_ps(d, d));
-      }
-      bits |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, h2, _CMP_LE_OQ))) << t;
+// Bits t < m <= 64 with d2 <= hi2, d2 the float distance2 of xi and candidate t of ax; with Band,
+// *sure gets those with d2 <= lo2 (CellIndex::hits64 says why two bounds).
+template <int Dim, bool Band>
+__attribute__((target("avx2"))) std::uint64_t hits64_avx2(const float* const* ax, const float* xi, float lo2,
+                                                          float hi2, std::uint32_t m, std::uint64_t* sure) {
+  std::uint64_t bits = 0, in = 0;
+  const __m256 h2 = _mm256_set1_ps(hi2), l2 = _mm256_set1_ps(lo2);
+  for (std::uint32_t t = 0; t < m; t += 8) {
+    __m256 d = _mm256_sub_ps(_mm256_set1_ps(xi[0]), _mm256_loadu_ps(ax[0] + t));
+    __m256 s2 = _mm256_mul_ps(d, d);
+    for (int k = 1; k < Dim; ++k) {
+      d = _mm256_sub_ps(_mm256_set1_ps(xi[k]), _mm256_loadu_ps(ax[k] + t));
+      s2 = _mm256_add_ps(s2, _mm256_mul_ps(d, d));
     }
-  } else {
-    const __m256d h2 = _mm256_set1_pd(hi2);
-    for (std::uint32_t t = 0; t < m; t += 4) {
-      __m256d d = _mm256_sub_pd(_mm256_set1_pd(xi[0]), _mm256_loadu_pd(ax[0] + t));
-      __m256d s2 = _mm256_mul_pd(d, d);
-      for (int k = 1; k < Dim; ++k) {
-        d = _mm256_sub_pd(_mm256_set1_pd(xi[k]), _mm256_loadu_pd(ax[k] + t));
-        s2 = _mm256_add_pd(s2, _mm256_mul_pd(d, d));
-      }
-      bits |= static_cast<std::uint64_t>(_mm256_movemask_pd(_mm256_cmp_pd(s2, h2, _CMP_LE_OQ))) << t;
-    }
+    bits |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, h2, _CMP_LE_OQ))) << t;
+    if constexpr (Band)
+      in |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, l2, _CMP_LE_OQ))) << t;
   }
-  return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
+  const std::uint64_t all = m == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << m) - 1;
+  if constexpr (Band) *sure = in & all;
+  return bits & all;
 }
 
 // Permutations that move the lanes set in an 8-bit mask to the front, in order (left-packing).
@@ -214,6 +211,8 @@ class CellIndex {
   // cost 2^32 distance tests each against the all-pairs reference.
   void limit_kept_order(std::uint32_t n) { kept_order_max_ = std::min(n, kKeptOrderMax); }
 
+  // x is read again by the queries of a double search (the exact test near h): it must outlive them,
+  // unchanged, as for AllPairs. h is copied.
   void build(std::span<const Point> x, std::span<const Real> h) {
     CELLSPH_CHECK(h.size() == x.size(), "support lengths " << h.size() << " != points " << x.size());
     build(x, h, Real(0));
@@ -247,6 +246,17 @@ class CellIndex {
     mask_ = h_mask<Dim>(reach);
     const int pad = mask_radius(reach);
     for (int k = 0; k < Dim; ++k) origin_[k] = double(b.lo[k]);
+    if constexpr (kBand) {
+      // Stored coordinates are x - origin_ (in [0, extent]) rounded to float: within extent 2^-24
+      // of it, or float's subnormal spacing near 0 (band() uses twice both).
+      double extent = 0;
+      for (int k = 0; k < Dim; ++k) extent = std::max(extent, double(b.hi[k]) - double(b.lo[k]));
+      band_all_ = !(extent <= 1e36);
+      band_m_ = 4 * std::max(extent * 0x1p-23, 0x1p-140);
+      band(hmax_, lo2_, hi2_);
+      band(Real(0), lo2_zero_, hi2_zero_);
+      xd_ = x.data();
+    }
 
     // Bits per axis: cell coordinates are shifted by `pad` so that every mask target (home + offset)
     // is non-negative and below 2^bits on every axis; targets off the grid then simply find no cell.
@@ -303,7 +313,12 @@ class CellIndex {
     return traverse<true>([&](std::uint32_t p, const Block& blk, const std::uint64_t*) {
       const std::uint32_t i = ids_[p];
       const Probe pr = probe(p);
-      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) { f(i, j, block_dist2(blk, pr.x, t)); });
+      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) {
+        if constexpr (kBand)
+          f(i, j, distance2(xd_[i], xd_[j]));
+        else
+          f(i, j, block_dist2(blk, pr.x, t));
+      });
     });
   }
 
@@ -380,7 +395,7 @@ class CellIndex {
                     zero_cell_.capacity() + ids_.capacity() * sizeof(std::uint32_t) +
                     deltas_.capacity() * sizeof(std::uint64_t) + mask_.capacity() * sizeof(MaskCell<Dim>) +
                     work_.size() * sizeof(std::uint64_t);
-    for (const auto& v : xs_) s += v.capacity() * sizeof(Real);
+    s += xs_.capacity() * sizeof(float);
     for (const auto& v : spill_) s += v.bytes();
     return s;
   }
@@ -408,9 +423,7 @@ class CellIndex {
           c += popcount64(bits);
         }
       } else {
-        for (std::uint32_t b = 0; b < blk.n; b += 64)
-          c += popcount64(hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b)));
-        --c;  // p itself is among its candidates at distance 0 <= h^2 and was counted once
+        for (std::uint32_t b = 0; b < blk.n; b += 64) c += popcount64(hits_but_self(p, blk, pr, b));
       }
       if (p + kAhead < n_) __builtin_prefetch(counts + ids_[p + kAhead], 1);
       counts[ids_[p]] = c;
@@ -474,7 +487,7 @@ class CellIndex {
     n_ = 0;
     cells_.clear();
     cell_start_.clear();
-    for (auto& v : xs_) v.clear();
+    xs_.clear();
     hs_.clear();
     zero_cell_.clear();
     ids_.clear();
@@ -540,7 +553,9 @@ class CellIndex {
     work_.reserve(kStoreWords * n);
     std::uint64_t* keys = work_.data();
     std::vector<std::uint64_t> wide_keys, scratch;  // the wide path only
-    ids_.resize(n);
+    // kPad spare entries, as for the positions: BlockBuffer copies ids in whole groups too.
+    ids_.resize(n + kPad);
+    std::fill(ids_.begin() + static_cast<std::ptrdiff_t>(n), ids_.end(), 0u);
     if (!wide_) {
       const int I = index_bits_;
       parallel_for(n, [&](std::size_t i) { keys[i] = (cell_key(x[i], pad) << I) | i; });
@@ -599,10 +614,13 @@ class CellIndex {
   void gather(std::span<const Point> x, std::span<const Real> h) {
     // kPad spare entries: BlockBuffer copies whole groups of kPad past the end of a range.
     // Every entry below n_ is written next: only the padding needs a value.
-    for (auto& v : xs_) {
-      v.resize(n_ + kPad);
-      std::fill(v.begin() + static_cast<std::ptrdiff_t>(n_), v.end(), Real(0));
+    const std::size_t stride = n_ + kPad;
+    if (xs_.capacity() < Dim * stride) {
+      xs_.clear();
+      xs_.shrink_to_fit();  // a larger set: never hold the old and the new copy at once
     }
+    xs_.resize(Dim * stride);
+    for (int k = 0; k < Dim; ++k) std::fill(xs(k) + n_, xs(k) + stride, 0.0f);
     // One support for all (the usual case) needs no array: hmax_ is every particle's.
     if (uniform_h_) {
       hs_.clear();
@@ -614,7 +632,14 @@ class CellIndex {
       // Reads in key order from particle order: a miss each unless asked for ahead.
       if (p + kAhead < n_) __builtin_prefetch(&x[ids_[p + kAhead]]);
       const std::uint32_t i = ids_[p];
-      for (int k = 0; k < Dim; ++k) xs_[k][p] = x[i][k];
+      for (int k = 0; k < Dim; ++k) {
+        if constexpr (kBand) {
+          const double c = std::min(double(x[i][k]) - origin_[k], 1e36);  // 1e36: band_all_
+          xs(k)[p] = static_cast<float>(c);
+        } else {
+          xs(k)[p] = x[i][k];
+        }
+      }
       if (!uniform_h_) hs_[p] = h[i];
     });
     // Cells whose particles all have support 0 (the solver's wall particles, which need no rows).
@@ -629,17 +654,6 @@ class CellIndex {
       for (std::uint32_t p = cell_start_[u]; p < cell_start_[u + 1]; ++p) zero = zero && hs_[p] == 0;
       zero_cell_[u] = zero ? 1 : 0;
     });
-  }
-
-  // The same expression, in the same order, as distance2(x[i], x[j]).
-  Real dist2(const Real* xi, std::uint32_t q) const {
-    Real d = xi[0] - xs_[0][q];
-    Real s = d * d;
-    for (int k = 1; k < Dim; ++k) {
-      d = xi[k] - xs_[k][q];
-      s += d * d;
-    }
-    return s;
   }
 
   static std::uint64_t popcount64(std::uint64_t v) {
@@ -698,9 +712,11 @@ class CellIndex {
   // A particle's candidates copied side by side, so that the distance loop runs over one
   // contiguous block instead of a few short ranges; padded by kPad.
   struct Block {
-    const Real* x[Dim];
-    const std::uint32_t* id;  // particle indices (only when asked for)
-    std::uint32_t* scratch;   // room for n + kPad entries: the fill pass gathers long rows there
+    const float* x[Dim];
+    const std::uint32_t* id;  // particle indices (only when has_ids)
+    const Range* r;           // the ranges the block was filled from, in order (key_index)
+    bool has_ids;
+    std::uint32_t* scratch;  // room for n + kPad entries: the fill pass gathers long rows there
     std::uint32_t n;
     // The home cell's particles are consecutive in the block: key-order particle p sits at
     // candidate self0 + (p - p0), unless the block was sorted by particle index (by_id), which
@@ -711,19 +727,46 @@ class CellIndex {
     [[nodiscard]] std::uint32_t self(std::uint32_t p) const {
       return by_id ? self_pos[p - p0] : self0 + (p - p0);
     }
+    // The key-order particle at candidate t of a block in range order (not by_id).
+    [[nodiscard]] std::uint32_t key_index(std::uint32_t t) const {
+      for (const Range* s = r;; ++s) {
+        const std::uint32_t len = s->end - s->begin;
+        if (t < len) return s->begin + t;
+        t -= len;
+      }
+    }
   };
 
-  // One particle's query: its position and h^2.
+  // One particle's query: its stored position and the bounds of hits64.
   struct Probe {
-    Real x[Dim];
-    Real h2;
+    float x[Dim];
+    float h2;         // float search: h^2; double search: the bound above which no candidate is a neighbour
+    float lo2;        // double search: the bound at or below which every candidate is one
+    Real h2r;         // double search: h^2, the exact test of the candidates in between
+    std::uint32_t i;  // double search: the particle (its caller's position)
   };
 
   Probe probe(std::uint32_t p) const {
     Probe pr{};
-    for (int k = 0; k < Dim; ++k) pr.x[k] = xs_[k][p];
+    for (int k = 0; k < Dim; ++k) pr.x[k] = xs(k)[p];
     const Real hp = uniform_h_ ? hmax_ : hs_[p];
-    pr.h2 = hp * hp;
+    pr.h2r = hp * hp;
+    if constexpr (kBand) {
+      pr.i = ids_[p];
+      // The solver's supports are hmax_ (fluid) and 0 (walls): their bounds are computed once.
+      if (hp == hmax_) {
+        pr.lo2 = lo2_;
+        pr.h2 = hi2_;
+      } else if (hp == 0) {
+        pr.lo2 = lo2_zero_;
+        pr.h2 = hi2_zero_;
+      } else {
+        band(hp, pr.lo2, pr.h2);
+      }
+    } else {
+      pr.h2 = pr.h2r;
+      pr.lo2 = pr.h2r;
+    }
     return pr;
   }
 
@@ -738,7 +781,7 @@ class CellIndex {
   }
 
   struct BlockBuffer {
-    std::array<std::vector<Real>, Dim> x, x_sorted;
+    std::array<std::vector<float>, Dim> x, x_sorted;
     std::vector<std::uint32_t> id, self_pos, scratch;
     std::vector<std::uint64_t> order, order2;
 
@@ -804,7 +847,7 @@ class CellIndex {
     // (with_x; a block whose hit masks were kept needs none) and their ids (with_ids).
     Block fill(const CellIndex& ci, const Range* r, int nr, std::uint32_t total, bool with_x, bool with_ids) {
       if (id.size() < total + kPad) {
-        for (auto& v : x) v.resize(total + kPad, Real(0));
+        for (auto& v : x) v.resize(total + kPad, 0.0f);
         id.resize(total + kPad, 0);
         scratch.resize(total + kPad);
       }
@@ -814,26 +857,33 @@ class CellIndex {
         // Whole groups of kPad: fixed-size copies the compiler inlines (ranges are ~10-30 long,
         // too short for a memmove call to pay); the overshoot lands in padding.
         for (int k = 0; k < Dim && with_x; ++k) {
-          const Real* src = ci.xs_[k].data() + b;
-          Real* dst = x[k].data() + o;
-          for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(Real));
+          const float* src = ci.xs(k) + b;
+          float* dst = x[k].data() + o;
+          for (std::uint32_t t = 0; t < len; t += kPad) std::memcpy(dst + t, src + t, kPad * sizeof(float));
         }
-        if (with_ids) std::copy_n(ci.ids_.data() + b, len, id.data() + o);
+        if (with_ids) {
+          const std::uint32_t* src = ci.ids_.data() + b;
+          std::uint32_t* dst = id.data() + o;
+          for (std::uint32_t t = 0; t < len; t += kPad)
+            std::memcpy(dst + t, src + t, kPad * sizeof(std::uint32_t));
+        }
         o += len;
       }
       Block blk{};
       for (int k = 0; k < Dim; ++k) blk.x[k] = x[k].data();
       blk.id = id.data();
+      blk.r = r;
+      blk.has_ids = with_ids;
       blk.scratch = scratch.data();
       blk.n = total;
       return blk;
     }
   };
 
-  // distance2 order again, on the block's copy of the positions.
-  static Real block_dist2(const Block& blk, const Real* xi, std::uint32_t t) {
-    Real d = xi[0] - blk.x[0][t];
-    Real s = d * d;
+  // distance2 order again, on the block's copy of the positions (float searches only).
+  static float block_dist2(const Block& blk, const float* xi, std::uint32_t t) {
+    float d = xi[0] - blk.x[0][t];
+    float s = d * d;
     for (int k = 1; k < Dim; ++k) {
       d = xi[k] - blk.x[k][t];
       s += d * d;
@@ -843,9 +893,9 @@ class CellIndex {
 
   // The hit mask of candidates [b, b + 64) of p's block without p itself.
   std::uint64_t hits_but_self(std::uint32_t p, const Block& blk, const Probe& pr, std::uint32_t b) const {
-    const std::uint64_t bits = hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b));
     const std::uint32_t s = blk.self(p) - b;  // wraps to a large value when self < b
-    return s < 64 ? bits & ~(std::uint64_t{1} << s) : bits;
+    const std::uint64_t self = s < 64 ? std::uint64_t{1} << s : 0;
+    return hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b), self) & ~self;
   }
 
   // Calls g(t, j) for every candidate t of the block, particle j != p, with distance2 <= h_p^2.
@@ -881,56 +931,113 @@ class CellIndex {
     return c;
   }
 
-  // Bit t set when distance2(xi, x_{b+t}) <= hi2 for the block's candidates b + t, t < m <= 64.
-  // Computed 8 floats (AVX2) or 4 (SSE2) at a time with the same operations in the same order as
-  // distance2, so the test is bit-identical to the all-pairs reference. Reads up to kPad entries
-  // past b + m (padding).
-  std::uint64_t hits64(const Block& blk, const Probe& pr, std::uint32_t b, std::uint32_t m) const {
-    const Real* xi = pr.x;
-    const Real hi2 = pr.h2;
-    const Real* ax[Dim];
+  // Bit t set when candidate b + t (t < m <= 64) is a neighbour: distance2(x_i, x_{b+t}) <= h_i^2
+  // in Real, exactly as the all-pairs reference decides it. Reads up to kPad entries past b + m
+  // (padding). Float searches test the block's float positions, 8 (AVX2) or 4 (SSE2) at a time with
+  // the same operations in the same order as distance2, so bit-identically. Double searches test the
+  // same float copies (relative to the origin: see xs_) against two bounds, lo2 <= hi2, that bracket
+  // h_i^2 by more than float's error in the positions and the arithmetic: a candidate at or below lo2
+  // is a neighbour and one above hi2 is not; the few in between are tested again in double, from the
+  // caller's positions, with distance2 itself.
+  // Bits in `skip` (p itself, which the caller drops) are not tested again in double.
+  std::uint64_t hits64(const Block& blk, const Probe& pr, std::uint32_t b, std::uint32_t m,
+                       std::uint64_t skip = 0) const {
+    const float* ax[Dim];
     for (int k = 0; k < Dim; ++k) ax[k] = blk.x[k] + b;
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-    if (avx2_) return detail::hits64_avx2<Dim, Real>(ax, xi, hi2, m);
-#endif
-    std::uint64_t bits = 0;
-#if defined(CELLSPH_CELL_INDEX_SSE2)
-    if constexpr (std::is_same_v<Real, float>) {
-      const __m128 h2 = _mm_set1_ps(hi2);
-      for (std::uint32_t t = 0; t < m; t += 4) {
-        __m128 d = _mm_sub_ps(_mm_set1_ps(xi[0]), _mm_loadu_ps(ax[0] + t));
-        __m128 s2 = _mm_mul_ps(d, d);
-        for (int k = 1; k < Dim; ++k) {
-          d = _mm_sub_ps(_mm_set1_ps(xi[k]), _mm_loadu_ps(ax[k] + t));
-          s2 = _mm_add_ps(s2, _mm_mul_ps(d, d));
-        }
-        bits |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, h2))) << t;
-      }
-    } else if constexpr (std::is_same_v<Real, double>) {
-      const __m128d h2 = _mm_set1_pd(hi2);
-      for (std::uint32_t t = 0; t < m; t += 2) {
-        __m128d d = _mm_sub_pd(_mm_set1_pd(xi[0]), _mm_loadu_pd(ax[0] + t));
-        __m128d s2 = _mm_mul_pd(d, d);
-        for (int k = 1; k < Dim; ++k) {
-          d = _mm_sub_pd(_mm_set1_pd(xi[k]), _mm_loadu_pd(ax[k] + t));
-          s2 = _mm_add_pd(s2, _mm_mul_pd(d, d));
-        }
-        bits |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmple_pd(s2, h2))) << t;
-      }
-    } else
-#endif
-    {
-      for (std::uint32_t t = 0; t < m; ++t) {
-        Real d = xi[0] - ax[0][t];
-        Real s2 = d * d;
-        for (int k = 1; k < Dim; ++k) {
-          d = xi[k] - ax[k][t];
-          s2 += d * d;
-        }
-        bits |= static_cast<std::uint64_t>(s2 <= hi2) << t;
-      }
+    std::uint64_t sure = 0;
+    const std::uint64_t maybe = float_hits<kBand>(ax, pr.x, pr.lo2, pr.h2, m, &sure);
+    if constexpr (!kBand) {
+      return maybe;
+    } else {
+      const std::uint64_t open = maybe & ~sure & ~skip;
+      return open == 0 ? sure : sure | retest(blk, pr, b, open);
     }
-    return m == 64 ? bits : bits & ((std::uint64_t{1} << m) - 1);
+  }
+
+  // hits64's exact test in double of the candidates b + t, t in `open`: the bits of the neighbours.
+  // Out of line: most calls have none, and inlined it crowds the float loop's registers.
+  [[gnu::noinline]] std::uint64_t retest(const Block& blk, const Probe& pr, std::uint32_t b,
+                                         std::uint64_t open) const {
+    std::uint64_t in = 0;
+    const Point& xi = xd_[pr.i];
+    for (; open != 0; open &= open - 1) {
+      const auto t = static_cast<std::uint32_t>(std::countr_zero(open));
+      const std::uint32_t j = blk.has_ids ? blk.id[b + t] : ids_[blk.key_index(b + t)];
+      // No branch: a lattice's pairs at exactly h (a scene's start) are in or out at random.
+      in |= static_cast<std::uint64_t>(distance2(xi, xd_[j]) <= pr.h2r) << t;
+    }
+    return in;
+  }
+
+  // hits64's float test: bits with d2 <= hi2, and with Band *sure gets those with d2 <= lo2.
+  template <bool Band>
+  std::uint64_t float_hits(const float* const* ax, const float* xi, float lo2, float hi2, std::uint32_t m,
+                           std::uint64_t* sure) const {
+#if defined(CELLSPH_CELL_INDEX_AVX2)
+    if (avx2_) return detail::hits64_avx2<Dim, Band>(ax, xi, lo2, hi2, m, sure);
+#endif
+    std::uint64_t bits = 0, in = 0;
+#if defined(CELLSPH_CELL_INDEX_SSE2)
+    const __m128 h2 = _mm_set1_ps(hi2), l2 = _mm_set1_ps(lo2);
+    for (std::uint32_t t = 0; t < m; t += 4) {
+      __m128 d = _mm_sub_ps(_mm_set1_ps(xi[0]), _mm_loadu_ps(ax[0] + t));
+      __m128 s2 = _mm_mul_ps(d, d);
+      for (int k = 1; k < Dim; ++k) {
+        d = _mm_sub_ps(_mm_set1_ps(xi[k]), _mm_loadu_ps(ax[k] + t));
+        s2 = _mm_add_ps(s2, _mm_mul_ps(d, d));
+      }
+      bits |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, h2))) << t;
+      if constexpr (Band) in |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, l2))) << t;
+    }
+#else
+    for (std::uint32_t t = 0; t < m; ++t) {
+      float d = xi[0] - ax[0][t];
+      float s2 = d * d;
+      for (int k = 1; k < Dim; ++k) {
+        d = xi[k] - ax[k][t];
+        s2 += d * d;
+      }
+      bits |= static_cast<std::uint64_t>(s2 <= hi2) << t;
+      if constexpr (Band) in |= static_cast<std::uint64_t>(s2 <= lo2) << t;
+    }
+#endif
+    const std::uint64_t all = m == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << m) - 1;
+    if constexpr (Band) *sure = in & all;
+    return bits & all;
+  }
+
+  // Float bounds around h^2 for a double search (hits64): a float distance2 at or below lo2 is
+  // certainly within h, one above hi2 certainly not. Each stored coordinate is within e = band_m_ / 4
+  // of x - origin, so a float distance is within 2 sqrt(Dim) e <= band_m_ of the true one, and its
+  // square carries at most (Dim + 3) rounding errors of 2^-24 (bounded by 2^-21 here); 2^-50 h more
+  // covers distance2's own rounding in double. Squares below 1e-30, where float's subnormals lose
+  // relative precision, are never sure; band_all_ makes every candidate a re-test.
+  void band(Real hp, float& lo2, float& hi2) const {
+    if (band_all_) {
+      lo2 = -1.0f;
+      hi2 = std::numeric_limits<float>::infinity();
+      return;
+    }
+    constexpr double c = 0x1p-21, s = 0x1p-50, tiny = 1e-30;
+    const double h = double(hp);
+    const double l = h * (1 - s) - band_m_, u = h * (1 + s) + band_m_;
+    const double lo = l > 0 ? l * l * (1 - c) : -1.0;
+    lo2 = lo >= tiny ? float_below(lo) : -1.0f;
+    hi2 = float_above(std::max(u * u * (1 + c), tiny));
+  }
+  // A float at most v (v >= 1e-30, so normal: rounding to nearest is within 2^-24 of v); +inf stays.
+  static float float_below(double v) {
+    v *= 1 - 0x1p-22;
+    if (v > double(std::numeric_limits<float>::max()))
+      return v == std::numeric_limits<double>::infinity() ? std::numeric_limits<float>::infinity()
+                                                          : std::numeric_limits<float>::max();
+    return static_cast<float>(v);
+  }
+  // A float at least v (v >= 1e-30).
+  static float float_above(double v) {
+    v *= 1 + 0x1p-22;
+    return v > double(std::numeric_limits<float>::max()) ? std::numeric_limits<float>::infinity()
+                                                         : static_cast<float>(v);
   }
 
   // Where find_all's count pass keeps the hit masks and its fill pass finds them (traverse).
@@ -1148,10 +1255,26 @@ class CellIndex {
   std::vector<std::uint64_t> deltas_;      // key offset of each mask cell, mod 2^64
   std::vector<std::uint64_t> cells_;       // distinct cell keys in order, + UINT64_MAX sentinel
   std::vector<std::uint32_t> cell_start_;  // first particle (key order) of each cell, + n
-  std::array<FreshVector<Real>, Dim> xs_;  // positions in key order, one array per axis
-  std::vector<Real> hs_;                   // support lengths in key order (empty when all are hmax_)
-  std::vector<std::uint8_t> zero_cell_;    // 1: every particle of the cell has support 0
-  FreshVector<std::uint32_t> ids_;         // key order -> particle index
+  // Positions in key order, one array per axis, in float: a float search's own values; a double
+  // search's x - origin_ rounded to float, half the bytes to hold and to copy into blocks and twice
+  // the candidates per SIMD test, with an exact test in double left to the few near h (hits64).
+  // One allocation (axis k at k (n + kPad)): large enough to be given 2 MiB pages.
+  FreshVector<float> xs_;
+  [[nodiscard]] float* xs(int k) {
+    return xs_.data() + std::size_t(k) * (n_ + kPad);
+  }
+  [[nodiscard]] const float* xs(int k) const {
+    return xs_.data() + std::size_t(k) * (n_ + kPad);
+  }
+  static constexpr bool kBand = !std::is_same_v<Real, float>;
+  const Point* xd_ = nullptr;  // double search: the caller's positions (build's x)
+  double band_m_ = 0;          // double search: 4 x the largest error of a stored coordinate (band)
+  bool band_all_ = false;      // double search: coordinates beyond float's range, every candidate re-tested
+  float lo2_ = 0, hi2_ = 0;    // double search: band's bounds for hmax_
+  float lo2_zero_ = 0, hi2_zero_ = 0;    // and for support 0
+  std::vector<Real> hs_;                 // support lengths in key order (empty when all are hmax_)
+  std::vector<std::uint8_t> zero_cell_;  // 1: every particle of the cell has support 0
+  FreshVector<std::uint32_t> ids_;       // key order -> particle index
   // The sort's keys and second buffer in build, find_all's kept hit masks (kStoreWords words a
   // particle) after: kept from one build to the next.
   mutable WorkBuffer work_;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <random>
 #include <string>
@@ -218,17 +219,17 @@ TEST(CellIndex, MatchesAllPairs3DDouble) {
   run_point_sets<3, double>();
 }
 
-// Pairs whose distance differs from h by less than float could resolve (a few ulps of double up to
-// 1e-6 h), in a box 300 h wide: the SIMD test in double must decide each as distance2 does.
-TEST(CellIndex, PairsWithinUlpsOfTheSupportMatchAllPairs) {
-  std::mt19937_64 rng(17);
+// `centres` random points in the box [0, box) and, around each, one point at distance h (1 + rel) per
+// rel, in a random direction: pairs whose distance2 falls within a few ulps (or more) of h^2.
+Points<3, double> pairs_near_the_support(std::uint64_t seed, int centres, const Vec<3, double>& box, double h,
+                                         std::initializer_list<double> rels) {
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double h = 0.37;
   Points<3, double> x;
-  for (int c = 0; c < 200; ++c) {
-    const Vec<3, double> o{{300 * h * u(rng), 300 * h * u(rng), 300 * h * u(rng)}};
+  for (int c = 0; c < centres; ++c) {
+    const Vec<3, double> o{{box[0] * u(rng), box[1] * u(rng), box[2] * u(rng)}};
     x.push_back(o);
-    for (double rel : {-1e-6, -1e-7, -3e-8, -1e-15, 0.0, 1e-15, 3e-8, 1e-7, 1e-6}) {
+    for (double rel : rels) {
       // A random direction, then the distance nudged until distance2 falls where we want it.
       Vec<3, double> d{{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5}};
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -236,20 +237,66 @@ TEST(CellIndex, PairsWithinUlpsOfTheSupportMatchAllPairs) {
       x.push_back({{o[0] + d[0], o[1] + d[1], o[2] + d[2]}});
     }
   }
-  const std::vector<double> hv(x.size(), h);
-  const NeighborList ref = all_pairs<3, double>(x, hv);
+  return x;
+}
+
+// Pairs whose distance differs from h by less than float could resolve (a few ulps of double up to
+// 1e-6 h), in a box 300 h wide: the float test and its re-test in double must decide each as
+// distance2 does.
+TEST(CellIndex, PairsWithinUlpsOfTheSupportMatchAllPairs) {
+  const double h = 0.37;
+  const Points<3, double> x = pairs_near_the_support(
+      17, 200, {{300 * h, 300 * h, 300 * h}}, h, {-1e-6, -1e-7, -3e-8, -1e-15, 0.0, 1e-15, 3e-8, 1e-7, 1e-6});
   std::size_t near = 0;  // pairs within float's resolution of the support
   for (std::size_t i = 0; i < x.size(); ++i)
     for (std::size_t j = 0; j < x.size(); ++j)
       near += i != j && std::abs(distance2(x[i], x[j]) - h * h) < 1e-6 * h * h ? 1 : 0;
   EXPECT_GT(near, 1000u);
-  CellIndex<3, double> ci;
-  ci.build(x, hv);
-  NeighborList a;
-  ci.find_all(a);
-  EXPECT_EQ(a.offsets, ref.offsets);
-  EXPECT_EQ(a.indices, ref.indices);
-  EXPECT_EQ(via_visitor(ci, x).indices, ref.indices);
+  expect_exact<3, double>(x, std::vector<double>(x.size(), h), "pairs within ulps of h");
+}
+
+// Double searches test float copies of the positions against bounds around h^2 and test again in
+// double only the candidates between them (CellIndex::hits64); the band widens with the extent of
+// the set (float's error in x - origin). Pairs within 1e-6 h of the support, in a box 3 x 10^4 h wide
+// (stored coordinates off by up to ~10^-3 h, so float alone would misjudge most of them), then with
+// an outlier 10^12 away (the band covers every candidate): every path expect_exact checks for the
+// box, find_all and the visitor with the outlier.
+TEST(CellIndex, DoubleSearchesDecideNearTheSupportInDoubleWhateverTheExtent) {
+  const double h = 0.37;
+  Points<3, double> x = pairs_near_the_support(29, 300, {{3e4 * h, 3e4 * h, 40 * h}}, h,
+                                               {-1e-3, -1e-6, -1e-9, -1e-15, 0.0, 1e-15, 1e-9, 1e-6, 1e-3});
+  for (bool outlier : {false, true}) {
+    if (outlier) x.push_back({{1e12, 0.0, 0.0}});
+    // Pairs that float coordinates put on the other side of h.
+    std::size_t misjudged = 0;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      for (std::size_t j = 0; j < x.size(); ++j) {
+        double s2 = 0;
+        for (int k = 0; k < 3; ++k) {
+          const float d = static_cast<float>(x[i][k]) - static_cast<float>(x[j][k]);
+          s2 += double(d) * double(d);
+        }
+        misjudged += i != j && (s2 <= h * h) != (distance2(x[i], x[j]) <= h * h) ? 1 : 0;
+      }
+    EXPECT_GT(misjudged, 100u) << (outlier ? "with an outlier" : "box 3e4 h wide");
+    const std::vector<double> hv(x.size(), h);
+    if (!outlier) {
+      expect_exact<3, double>(x, hv, "box 3e4 h wide");
+      continue;
+    }
+    // The outlier needs the wide keys, which expect_exact's packed runs assert against.
+    const NeighborList ref = all_pairs<3, double>(x, hv);
+    for (int threads : {1, 2}) {
+      ScopedThreads st(threads);
+      CellIndex<3, double> ci;
+      ci.build(x, hv);
+      NeighborList a;
+      ci.find_all(a);
+      EXPECT_EQ(a.offsets, ref.offsets);
+      EXPECT_EQ(a.indices, ref.indices);
+      EXPECT_EQ(via_visitor(ci, x).indices, ref.indices);
+    }
+  }
 }
 
 // Cells holding hundreds of particles: their shared candidate blocks (from 320) are sorted by index

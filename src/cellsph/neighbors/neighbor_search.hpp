@@ -42,6 +42,8 @@ class NeighborSearch {
   }
 
   // Builds the structure for positions x with one support length per particle (h.size() == n).
+  // x must stay alive and unchanged until the last query of this build: all-pairs and a double
+  // Cell Indexing search read it again.
   void build(std::span<const Point> x, std::span<const Real> h) {
     CELLSPH_CHECK(h.size() == x.size(), "support lengths " << h.size() << " != points " << x.size());
     n_ = x.size();
