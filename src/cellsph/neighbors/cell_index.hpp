@@ -248,11 +248,12 @@ class CellIndex {
     for (int k = 0; k < Dim; ++k) origin_[k] = double(b.lo[k]);
     if constexpr (kBand) {
       // Stored coordinates are x - origin_ (in [0, extent]) rounded to float: within extent 2^-24
-      // of it, or float's subnormal spacing near 0 (band() uses twice both).
+      // of it, or float's subnormal spacing near 0 (band() uses twice both). Beyond 1e36 (float's
+      // range) the band is infinite: every candidate is tested again in double.
       double extent = 0;
       for (int k = 0; k < Dim; ++k) extent = std::max(extent, double(b.hi[k]) - double(b.lo[k]));
-      band_all_ = !(extent <= 1e36);
-      band_m_ = 4 * std::max(extent * 0x1p-23, 0x1p-140);
+      band_m_ =
+          extent <= 1e36 ? 4 * std::max(extent * 0x1p-23, 0x1p-140) : std::numeric_limits<double>::infinity();
       band(hmax_, lo2_, hi2_);
       band(Real(0), lo2_zero_, hi2_zero_);
       xd_ = x.data();
@@ -634,7 +635,7 @@ class CellIndex {
       const std::uint32_t i = ids_[p];
       for (int k = 0; k < Dim; ++k) {
         if constexpr (kBand) {
-          const double c = std::min(double(x[i][k]) - origin_[k], 1e36);  // 1e36: band_all_
+          const double c = std::min(double(x[i][k]) - origin_[k], 1e36);  // beyond it band_m_ is infinite
           xs(k)[p] = static_cast<float>(c);
         } else {
           xs(k)[p] = x[i][k];
@@ -764,8 +765,7 @@ class CellIndex {
         band(hp, pr.lo2, pr.h2);
       }
     } else {
-      pr.h2 = pr.h2r;
-      pr.lo2 = pr.h2r;
+      pr.h2 = pr.h2r;  // lo2 is not read: float_hits<false>
     }
     return pr;
   }
@@ -1011,13 +1011,9 @@ class CellIndex {
   // of x - origin, so a float distance is within 2 sqrt(Dim) e <= band_m_ of the true one, and its
   // square carries at most (Dim + 3) rounding errors of 2^-24 (bounded by 2^-21 here); 2^-50 h more
   // covers distance2's own rounding in double. Squares below 1e-30, where float's subnormals lose
-  // relative precision, are never sure; band_all_ makes every candidate a re-test.
+  // relative precision, are never sure. An infinite band_m_ gives lo2 = -1 and hi2 = +inf: every
+  // candidate a re-test.
   void band(Real hp, float& lo2, float& hi2) const {
-    if (band_all_) {
-      lo2 = -1.0f;
-      hi2 = std::numeric_limits<float>::infinity();
-      return;
-    }
     constexpr double c = 0x1p-21, s = 0x1p-50, tiny = 1e-30;
     const double h = double(hp);
     const double l = h * (1 - s) - band_m_, u = h * (1 + s) + band_m_;
@@ -1268,9 +1264,8 @@ class CellIndex {
   }
   static constexpr bool kBand = !std::is_same_v<Real, float>;
   const Point* xd_ = nullptr;  // double search: the caller's positions (build's x)
-  double band_m_ = 0;          // double search: 4 x the largest error of a stored coordinate (band)
-  bool band_all_ = false;      // double search: coordinates beyond float's range, every candidate re-tested
-  float lo2_ = 0, hi2_ = 0;    // double search: band's bounds for hmax_
+  double band_m_ = 0;  // double search: 4 x a stored coordinate's largest error (band); inf: all re-tested
+  float lo2_ = 0, hi2_ = 0;              // double search: band's bounds for hmax_
   float lo2_zero_ = 0, hi2_zero_ = 0;    // and for support 0
   std::vector<Real> hs_;                 // support lengths in key order (empty when all are hmax_)
   std::vector<std::uint8_t> zero_cell_;  // 1: every particle of the cell has support 0
