@@ -314,7 +314,7 @@ class CellIndex {
     return traverse<true>([&](std::uint32_t p, const Block& blk, const std::uint64_t*) {
       const std::uint32_t i = ids_[p];
       const Probe pr = probe(p);
-      for_each_hit(p, blk, [&](std::uint32_t t, std::uint32_t j) {
+      for_each_hit(p, blk, pr, [&](std::uint32_t t, std::uint32_t j) {
         if constexpr (kBand)
           f(i, j, distance2(xd_[i], xd_[j]));
         else
@@ -898,10 +898,10 @@ class CellIndex {
     return hits64(blk, pr, b, std::min<std::uint32_t>(64, blk.n - b), self) & ~self;
   }
 
-  // Calls g(t, j) for every candidate t of the block, particle j != p, with distance2 <= h_p^2.
+  // Calls g(t, j) for every candidate t of the block, particle j != p, with distance2 <= h_p^2
+  // (pr: probe(p)).
   template <class G>
-  void for_each_hit(std::uint32_t p, const Block& blk, G&& g) const {
-    const Probe pr = probe(p);
+  void for_each_hit(std::uint32_t p, const Block& blk, const Probe& pr, G&& g) const {
     for (std::uint32_t b = 0; b < blk.n; b += 64) {
       // About 1 candidate in 7 is a neighbour: iterating the set bits of a hit mask costs one
       // step per neighbour and no branch per candidate.
