@@ -8,7 +8,10 @@ Usage: scripts/validate.py CASE [--spacing S] [--until T] [--build DIR] [--out R
 CASE is `lobovsky` (built-in scene lobovsky-2014: Lobovsky et al. 2014, H = 0.3 m, 2D), `lobovsky-gate`
 (built-in scene lobovsky-2014-gate: the same column released by the experiment's gate, lifted at 4.5 m/s
 from t = 0; --compare RUN_DIR draws another run, e.g. the instant release's, dashed), `spheric`
-(built-in scene spheric-test2: SPHERIC Test 2, Kleefsman et al. 2005, 3D) or `martin-moyce-a` /
+(built-in scene spheric-test2: SPHERIC Test 2, Kleefsman et al. 2005, 3D), `spheric-2d` (SPHERIC's
+column in 2D, lobovsky-2014 edited: its surge at x = 1.488 m for t <= 1 s, before the box's reflection
+arrives, against the experiment and the shallow-water dam break of scripts/shallow_water.py; cheap
+enough for a resolution series) or `martin-moyce-a` /
 `martin-moyce-b` (dam-break-2d's set-up against Martin & Moyce 1952's residual column height at the back
 wall, tables [A] and [B] of data/validation/martin_moyce_1952.txt: [A] the scene's 1 m x 2 m column in its
 4 m tank, tau = t sqrt(g / a) <= 2.5; [B] a 1 m square column in an 8 m tank, tau <= 6.3; the level on
@@ -26,7 +29,9 @@ RUN_DIR. Then, against the data of data/validation/:
     is printed as the experiment's spread), as a fraction of the gauge's measured peak level in the window;
   - SPHERIC: the peak pressure and its time at every sensor over the first impact (t < 1 s), P1 being the
     issue's target; P1's impulse over 0.38-0.50 s (the impact's time integral, which the weakly
-    compressible model's acoustic spikes do not change: docs/physics.md) and its mean over 0.45-1 s.
+    compressible model's acoustic spikes do not change: docs/physics.md) and its mean over 0.45-1 s;
+  - SPHERIC (and spheric-2d): the level at x = 1.488 m over 0.3-1 s against the shallow-water dam break of
+    the same column, for the run and for the experiment (mean of level / reference - 1).
 Prints one line per quantity with the issue's target and "met" or "MISSED"; writes the figure (default
 RUN_DIR/validation.png; matplotlib from Debian). Exits 0 when it could compare, whatever the result
 (a report, not a test: the CI bounds are in src/cellsph/scene/validation_test.cpp).
@@ -68,6 +73,7 @@ SPHERIC = {
     "sensors_top": [0.8035, 0.7635, 0.7235, 0.6835],  # P5-P8: x on the top z = 0.161
     "sensor_y": 0.471,
 }
+SPHERIC_2D = {"scene": "lobovsky-2014"}
 
 
 class Table(dict):
@@ -204,6 +210,9 @@ def run_scene(a, case):
     if case is SPHERIC:
         for e in spheric_geometry(a.spacing):
             cmd += ["--set", e]
+    if case is SPHERIC_2D:
+        for e in spheric_2d_edits(a.spacing):
+            cmd += ["--set", e]
     if case in ("A", "B"):
         m = MM[case]
         probe = [{"name": "wall", "kind": "level", "at": [2 * a.spacing, 0]}]
@@ -212,7 +221,7 @@ def run_scene(a, case):
                 "--set", "/probes_every=0.005", "--set", "/probes=" + json.dumps(probe)]
     for e in a.set:
         cmd += ["--set", e]
-    print("validate.py: " + " ".join(cmd if case is not SPHERIC else cmd[:17]) + " ...", flush=True)
+    print("validate.py: " + " ".join(cmd if case not in (SPHERIC, SPHERIC_2D) else cmd[:17]) + " ...", flush=True)
     r = subprocess.run(cmd)
     if r.returncode != 0:
         sys.exit(f"validate.py: cellsph run failed (exit {r.returncode})")
@@ -301,6 +310,8 @@ def compare_spheric(run_dir, t_end):
                      f"{100 * (ps - pe) / pe:+.1f}% (target 25%: {verdict(abs(ps - pe) <= 0.25 * pe)})")
             rows.append({"gauge": name, "peak_time": ts, "peak_time_exp": te, "peak": ps, "peak_exp": pe})
         print(line)
+    if sim["time"][-1] >= SW_WINDOW[1]:
+        shallow_water_check(run_dir, sim, data)
     if sim["time"][-1] >= 0.5:
         js, je = impulse(sim["time"], sim["P1"]), impulse(dt, data["P1"])
         print(f"  P1: impulse over 0.38-0.50 s (the first impact's time integral) {js:.0f} Pa s, experiment "
@@ -313,6 +324,77 @@ def compare_spheric(run_dir, t_end):
         print(f"  P1: mean over 0.45-1 s (the load after the impact) {ms:.0f} Pa, experiment {me:.0f} Pa: "
               f"{100 * (ms - me) / me:+.1f}%")
     return sim, data, rows, window
+
+
+SW_WINDOW = (0.3, 1.0)  # [s]: the surge at x = 1.488 m before the box's reflection reaches it (about 1.0 s)
+
+
+def below_shallow_water(ts, levels, height, dam, length, x):
+    """(mean of level / reference - 1 over SW_WINDOW, the reference's (times, depths)): a gauge at x against
+    the shallow-water dam break of a column of depth `height` over [dam, length] (scripts/shallow_water.py)."""
+    if HERE not in sys.path:
+        sys.path.insert(0, HERE)
+    import shallow_water
+    sw_t, depth, _ = shallow_water.dam_break(height, dam, length, [x], SW_WINDOW[1] + 0.05, cells=1500)
+    rel = [interp(ts, levels, t) / interp(sw_t, depth[x], t) - 1 for t in ts if SW_WINDOW[0] <= t <= SW_WINDOW[1]]
+    return sum(rel) / len(rel), (sw_t, depth[x])
+
+
+def shallow_water_check(run_dir, sim, data):
+    """x = 1.488 m against the shallow-water dam break of each side's own column: the run's column from its
+    run.json and the first reading of its column gauge, the experiment's from the data's. Stores the
+    reference series as sim["sw_level_x1488"] and data["sw_level_x1488"] for the figure."""
+    g, x = "level_x1488", SPHERIC["gauges"]["level_x1488"]
+    path = os.path.join(run_dir, "run.json")
+    if not os.path.exists(path):
+        print(f"  {g}: no shallow-water comparison ({path} not found: it gives the run's column)")
+        return
+    with open(path) as f:
+        scene = json.load(f)["scene"]
+    sides = {"run": (sim, "time", scene["fluids"][0]["min"][0], scene["boundary"]["walls"]["max"][0]),
+             "experiment": (data, "t_s", 1.992, 3.22)}
+    parts = []
+    for side, (cols, tkey, dam, length) in sides.items():
+        height = cols["level_x2638"][0]
+        rel, cols["sw_" + g] = below_shallow_water(cols[tkey], cols[g], height, dam, length, x)
+        parts.append(f"{side} {100 * rel:+.1f}% (column {height:.3f} m, dam at x = {dam:g} m)")
+    print(f"  {g} against the shallow-water dam break of the same column over {SW_WINDOW[0]:g}-{SW_WINDOW[1]:g} s "
+          f"(mean level / reference - 1): " + "; ".join(parts))
+
+
+def spheric_2d_edits(s):
+    """The --set edits that turn lobovsky-2014 into SPHERIC Test 2's column in 2D at spacing s: the column
+    (1.228 m on the lattice x 0.55 m) against the wall at x = 0, the 3.22 m tank with a roof at 1 m, the
+    sound speed of its height, and the gauges mirrored: x = 1.488 m (0.504 m downstream of the column)
+    and x = 2.638 m (in the column, 0.582 m from its wall)."""
+    col = lround(1.228 / s) * s
+    probes = [{"name": "level_x1488", "kind": "layer", "at": [col + 0.504, 0]},
+              {"name": "level_x2638", "kind": "layer", "at": [0.582, 0]}]
+    return [f"/fluids/0/max=[{col!r}, 0.55]", "/boundary/walls/max=[3.22, 1.0]", "/boundary/walls/open_top=false",
+            "/domain/max=[3.72, 3.0]", f"/solver/eos/stiffness={1000 * 100 * 2 * G * 0.55!r}",
+            "/probes=" + json.dumps(probes)]
+
+
+def compare_spheric_2d(run_dir):
+    """The 2D column's surge at x = 1.488 m against the shallow-water reference and the experiment, t <= 1 s
+    (before the box's reflection reaches that gauge in 3D)."""
+    _, data = read_table(os.path.join(ROOT, "data", "validation", SPHERIC["data"]))
+    _, sim = read_table(os.path.join(run_dir, "probes.csv"))
+    with open(os.path.join(run_dir, "run.json")) as f:
+        col = json.load(f)["scene"]["fluids"][0]["max"][0]
+    g = "level_x1488"
+    # Mirrored into shallow_water's frame: the column over [3.22 - col, 3.22], the gauge 0.504 m below it.
+    rel, sim["sw_" + g] = below_shallow_water(sim["time"], sim[g], sim["level_x2638"][0], 3.22 - col, 3.22,
+                                              3.22 - col - 0.504)
+    rel_e, data["sw_" + g] = below_shallow_water(data["t_s"], data[g], data["level_x2638"][0], 1.992, 3.22, 1.488)
+    end = min(SW_WINDOW[1], sim["time"][-1])
+    top = max(v for t, v in zip(data["t_s"], data[g]) if t <= end)
+    err = rms_error(sim["time"], sim[g], data["t_s"], data[g], end)
+    print(f"SPHERIC Test 2's column in 2D, x = 1.488 m, t <= {end:g} s:\n"
+          f"  level RMS error against the experiment {err:.4f} m = {100 * err / top:.1f}% of its peak {top:.3f} m\n"
+          f"  mean level / shallow-water reference - 1 over {SW_WINDOW[0]:g}-{SW_WINDOW[1]:g} s: run "
+          f"{100 * rel:+.1f}%, experiment {100 * rel_e:+.1f}%")
+    return sim, data
 
 
 def compare_martin_moyce(run_dir, table):
@@ -351,6 +433,18 @@ def figure(path, case, sim, ref, window, title, other=None):
         ax.set_ylabel("residual height / column height")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
+    elif case is SPHERIC_2D:
+        fig, ax = plt.subplots(1, 1, figsize=(6, 3.6))
+        g = "level_x1488"
+        m = [i for i, t in enumerate(ref["t_s"]) if t <= sim["time"][-1]]
+        ax.plot([ref["t_s"][i] for i in m], [ref[g][i] for i in m], "k-", lw=0.6, label="experiment")
+        ax.plot(sim["time"], sim[g], "C0-", lw=1.2, label="cellsph, 2D")
+        ax.plot(*sim["sw_" + g], "C0:", lw=1.0, label="shallow water, the run's column")
+        ax.plot(*ref["sw_" + g], "k:", lw=1.0, label="shallow water, the experiment's column")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("level at x = 1.488 m [m]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
     elif case in (LOBOVSKY, LOBOVSKY_GATE):
         fig, axes = plt.subplots(2, 2, figsize=(9, 5.5), sharex=True)
         for ax, g in zip(axes.flat, case["gauges"]):
@@ -374,6 +468,10 @@ def figure(path, case, sim, ref, window, title, other=None):
             m = [i for i, t in enumerate(ref["t_s"]) if t <= max(window, sim["time"][-1]) + 0.1]
             ax.plot([ref["t_s"][i] for i in m], [ref[g][i] for i in m], "k-", lw=0.6, label="experiment")
             ax.plot(sim["time"], sim[g], "C0-", lw=1.2, label="cellsph")
+            if "sw_" + g in sim:
+                ax.plot(*sim["sw_" + g], "C0:", lw=1.0, label="shallow water, the run's column")
+                ax.plot(*ref["sw_" + g], "k:", lw=1.0, label="shallow water, the experiment's column")
+                ax.legend(fontsize=7)
             ax.set_title(f"level at x = {case['gauges'][g]} m" if k < 4 else f"pressure {g}", fontsize=9)
             ax.set_ylabel("level [m]" if k < 4 else "p [Pa]")
             ax.grid(alpha=0.3)
@@ -388,7 +486,8 @@ def figure(path, case, sim, ref, window, title, other=None):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=["lobovsky", "lobovsky-gate", "spheric", "martin-moyce-a", "martin-moyce-b"])
+    ap.add_argument("case", choices=["lobovsky", "lobovsky-gate", "spheric", "spheric-2d", "martin-moyce-a",
+                                     "martin-moyce-b"])
     ap.add_argument("--walls", default="adami", choices=["adami", "akinci", "dynamic"])
     ap.add_argument("--set", action="append", default=[], help="a further scene edit, as cellsph run's --set")
     ap.add_argument("--spacing", type=float)
@@ -401,15 +500,16 @@ def main():
     ap.add_argument("--compare", metavar="RUN_DIR", help="Lobovsky: also draw this run's levels (dashed)")
     ap.add_argument("--compare-label", default="other run", help="the legend of --compare's run")
     a = ap.parse_args()
-    case = {"lobovsky": LOBOVSKY, "lobovsky-gate": LOBOVSKY_GATE, "spheric": SPHERIC, "martin-moyce-a": "A",
+    case = {"lobovsky": LOBOVSKY, "lobovsky-gate": LOBOVSKY_GATE, "spheric": SPHERIC, "spheric-2d": SPHERIC_2D,
+            "martin-moyce-a": "A",
             "martin-moyce-b": "B"}[a.case]
     if a.spacing is None:
-        a.spacing = {"lobovsky": 0.005, "lobovsky-gate": 0.005, "spheric": 0.02}.get(a.case, 0.05)
+        a.spacing = {"lobovsky": 0.005, "lobovsky-gate": 0.005, "spheric": 0.02, "spheric-2d": 0.005}.get(a.case, 0.05)
     if not a.spacing > 0:
         sys.exit(f"--spacing: must be > 0, got {a.spacing}")
     if a.until is None:
         a.until = {"lobovsky": 6 * math.sqrt(LOBOVSKY["H"] / G), "lobovsky-gate": 6 * math.sqrt(LOBOVSKY["H"] / G),
-                   "spheric": 2.0,
+                   "spheric": 2.0, "spheric-2d": SW_WINDOW[1],
                    "martin-moyce-a": 2.5 / math.sqrt(G), "martin-moyce-b": 6.35 / math.sqrt(G)}[a.case]
     a.out = a.out or f"validate-{a.case}-{a.spacing:g}"
     if a.compare and case not in (LOBOVSKY, LOBOVSKY_GATE):
@@ -429,6 +529,10 @@ def main():
         sim, ref, _, window = compare_lobovsky(a.out, a.until)
         title = (f"{case['scene']}, 2D WCSPH, spacing {a.spacing:g} m (H / {0.3 / a.spacing:.0f}), "
                  "against Lobovsky et al. 2014 (two series)")
+    elif case is SPHERIC_2D:
+        sim, ref = compare_spheric_2d(a.out)
+        window = None
+        title = f"SPHERIC Test 2's column in 2D (lobovsky-2014 edited), spacing {a.spacing:g} m"
     else:
         sim, ref, _, window = compare_spheric(a.out, a.until)
         title = f"spheric-test2, 3D WCSPH, spacing {a.spacing:g} m, against Kleefsman et al. 2005"
