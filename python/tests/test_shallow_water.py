@@ -94,3 +94,19 @@ def test_spheric_2d_mirrors_the_column_and_reports_a_made_up_run(repo_root, tmp_
                         "--out", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "run -20.0%, experiment " in r.stdout, r.stdout
+
+
+def test_the_2d_surge_lies_just_below_the_shallow_water_depth(cellsph_binary, repo_root, tmp_path):
+    # SPHERIC's column in 2D at 0.02 m (2 400 particles), run by validate.py: its level 0.504 m downstream of
+    # the column over 0.3-1 s against the shallow-water dam break of the same column. A real surge is
+    # shallower than the shallow-water depth (vertical accelerations at the front, friction at the floor):
+    # the resolution series of docs/physics.md converges to 10% below it. The bound: below it, by less than
+    # 15%. A model that drains the column too slowly or drags the surge along the floor falls outside.
+    build = os.path.dirname(cellsph_binary)
+    r = subprocess.run([sys.executable, os.path.join(repo_root, "scripts", "validate.py"), "spheric-2d",
+                        "--spacing", "0.02", "--build", build, "--threads", "2", "--out", str(tmp_path / "run")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    line = next(ln for ln in r.stdout.splitlines() if "shallow-water reference" in ln)
+    rel = float(line.split("run ")[1].split("%")[0])
+    assert -15.0 < rel < 0.0, line
