@@ -337,7 +337,7 @@ def below_shallow_water(ts, levels, height, dam, length, x):
     import shallow_water
     sw_t, depth, _ = shallow_water.dam_break(height, dam, length, [x], SW_WINDOW[1] + 0.05, cells=1500)
     rel = [interp(ts, levels, t) / interp(sw_t, depth[x], t) - 1 for t in ts if SW_WINDOW[0] <= t <= SW_WINDOW[1]]
-    return sum(rel) / len(rel), (sw_t, depth[x])
+    return (sum(rel) / len(rel) if rel else math.nan), (sw_t, depth[x])
 
 
 def shallow_water_check(run_dir, sim, data):
@@ -380,7 +380,13 @@ def compare_spheric_2d(run_dir):
     (before the box's reflection reaches that gauge in 3D)."""
     _, data = read_table(os.path.join(ROOT, "data", "validation", SPHERIC["data"]))
     _, sim = read_table(os.path.join(run_dir, "probes.csv"))
-    with open(os.path.join(run_dir, "run.json")) as f:
+    path = os.path.join(run_dir, "run.json")
+    if not os.path.exists(path):
+        sys.exit(f"{path}: not found (it gives the run's column; run without --no-run first)")
+    if sim["time"][-1] < SW_WINDOW[0]:
+        sys.exit(f"{os.path.join(run_dir, 'probes.csv')}: ends at t = {sim['time'][-1]:g} s, before the "
+                 f"comparison's window {SW_WINDOW[0]:g}-{SW_WINDOW[1]:g} s")
+    with open(path) as f:
         col = json.load(f)["scene"]["fluids"][0]["max"][0]
     g = "level_x1488"
     # Mirrored into shallow_water's frame: the column over [3.22 - col, 3.22], the gauge 0.504 m below it.

@@ -110,3 +110,15 @@ def test_the_2d_surge_lies_just_below_the_shallow_water_depth(cellsph_binary, re
     line = next(ln for ln in r.stdout.splitlines() if "shallow-water reference" in ln)
     rel = float(line.split("run ")[1].split("%")[0])
     assert -15.0 < rel < 0.0, line
+
+
+def test_spheric_2d_refuses_a_run_without_its_scene_or_too_short(repo_root, tmp_path):
+    script = os.path.join(repo_root, "scripts", "validate.py")
+    (tmp_path / "probes.csv").write_text("time,level_x1488,level_x2638\n0,0,0.55\n0.1,0,0.55\n")
+    r = subprocess.run([sys.executable, script, "spheric-2d", "--no-run", "--out", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "run.json: not found" in r.stderr and "Traceback" not in r.stderr, r.stderr
+    (tmp_path / "run.json").write_text(json.dumps({"scene": {"fluids": [{"min": [0, 0], "max": [1.23, 0.55]}]}}))
+    r = subprocess.run([sys.executable, script, "spheric-2d", "--no-run", "--out", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and "ends at t = 0.1 s" in r.stderr and "Traceback" not in r.stderr, r.stderr
