@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The dam break in the shallow-water equations: an independent reference for the depth of a surge.
 
 Usage: scripts/shallow_water.py --height H --dam X0 --length L --at X [--at X ...] [--until T] [--every DT]
