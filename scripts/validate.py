@@ -477,7 +477,6 @@ def figure(path, case, sim, ref, window, title, other=None):
             if "sw_" + g in sim:
                 ax.plot(*sim["sw_" + g], "C0:", lw=1.0, label="shallow water, the run's column")
                 ax.plot(*ref["sw_" + g], "k:", lw=1.0, label="shallow water, the experiment's column")
-                ax.legend(fontsize=7)
             ax.set_title(f"level at x = {case['gauges'][g]} m" if k < 4 else f"pressure {g}", fontsize=9)
             ax.set_ylabel("level [m]" if k < 4 else "p [Pa]")
             ax.grid(alpha=0.3)
