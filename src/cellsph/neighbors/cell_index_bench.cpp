@@ -39,12 +39,16 @@ const std::vector<Vec<3, float>>& point_set(std::int64_t set) {
 }
 
 // Build + find_all, as `cellsph neighbors` runs it, on warm lists (reused across iterations).
-// Args: subdivision H; set (0 lattice, 1 uniform, 2 uniform in cell order).
+// Args: subdivision H; set (0 lattice, 1 uniform, 2 uniform in cell order); sorted (1: rows
+// ascending, the default; 0: rows in the search's own order, as TreeNSearch leaves them).
 void BM_CellIndexBuildAndLists(benchmark::State& state) {
   ScopedThreads threads(2);
   const auto& x = point_set(state.range(1));
   const std::vector<float> h(x.size(), 2.0f);
-  CellIndex<3, float> ci({.method = Method::CellIndex, .subdivision = static_cast<int>(state.range(0))});
+  CellIndex<3, float> ci({.method = Method::CellIndex,
+                          .subdivision = static_cast<int>(state.range(0)),
+                          .hash_table_size = 0,
+                          .sorted_rows = state.range(2) != 0});
   NeighborList nl;
   double build_ms = 0, query_ms = 0;
   std::uint64_t cand = 0;
@@ -68,12 +72,15 @@ void BM_CellIndexBuildAndLists(benchmark::State& state) {
   state.counters["lists_MB"] = static_cast<double>(nl.memory_bytes()) / 1e6;
 }
 BENCHMARK(BM_CellIndexBuildAndLists)
-    ->ArgNames({"H", "set"})
-    ->Args({1, 0})
-    ->Args({2, 0})
-    ->Args({3, 0})
-    ->Args({1, 1})
-    ->Args({1, 2})
+    ->ArgNames({"H", "set", "sorted"})
+    ->Args({1, 0, 1})
+    ->Args({2, 0, 1})
+    ->Args({3, 0, 1})
+    ->Args({1, 1, 1})
+    ->Args({1, 2, 1})
+    ->Args({1, 0, 0})
+    ->Args({1, 1, 0})
+    ->Args({1, 2, 0})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
