@@ -399,6 +399,51 @@ TEST(NeighborsCli, PointsFarBeyondAKeysReachStillGetTheirPairs) {
   }
 }
 
+// --unsorted-rows: cell-index lists each row in its own order. Every row holds the brute-force set, the
+// output is the same bytes for 1 and 2 threads, and some row is out of ascending order (so the flag
+// reached the search). Another method lists its rows ascending, flag or not.
+TEST(NeighborsCli, UnsortedRowsHoldTheSamePairsInTheSearchsOrder) {
+  TempDir dir;
+  const Cloud c = test_cloud(3, 400, 17);
+  write_file(dir / "in.csv", to_csv(c));
+  auto rows_of = [](const std::string& csv) {
+    std::vector<std::vector<std::size_t>> rows;
+    std::istringstream in(csv);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      const auto comma = line.find(',');
+      const std::size_t i = std::stoul(line.substr(0, comma)), j = std::stoul(line.substr(comma + 1));
+      if (rows.size() <= i) rows.resize(i + 1);
+      rows[i].push_back(j);
+    }
+    return rows;
+  };
+  std::string outputs[2];
+  for (int t = 1; t <= 2; ++t) {
+    const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
+                                    " --radius 1.25 --unsorted-rows --threads " + std::to_string(t) +
+                                    " --output " + q(dir / "out.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    outputs[t - 1] = read_file(dir / "out.csv");
+  }
+  EXPECT_EQ(outputs[0], outputs[1]) << "the order depends on the thread count";
+  auto rows = rows_of(outputs[0]);
+  const auto expected = brute_force(c, 1.25);
+  rows.resize(expected.size());
+  bool some_unsorted = false;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    some_unsorted = some_unsorted || !std::is_sorted(rows[i].begin(), rows[i].end());
+    std::sort(rows[i].begin(), rows[i].end());
+    ASSERT_EQ(rows[i], expected[i]) << "row " << i;
+  }
+  EXPECT_TRUE(some_unsorted) << "every row came out ascending: --unsorted-rows did not reach the search";
+  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
+                                  " --radius 1.25 --unsorted-rows --method kd-tree --output " + q(dir / "kd.csv"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_file(dir / "kd.csv"), expected_pairs_csv(expected));
+}
+
 TEST(NeighborsCliInput, CommandLineParseErrorsExitTwo) {
   TempDir dir;
   write_file(dir / "in.csv", kGood);

@@ -36,6 +36,7 @@ struct NeighborsArgs {
   bool threads_given = false;
   bool counts = false;
   bool stats = false;
+  bool unsorted_rows = false;
 };
 
 // Output is formatted by hand into a large buffer: ostream << per number is ~10x slower, and the
@@ -81,7 +82,8 @@ template <int Dim>
 void run(const NeighborsArgs& a, double radius, Method method, const PointsTable& table, AtomicFile& out) {
   using Real = double;
   const auto x = table.points<Dim, Real>();
-  NeighborSearch<Dim, Real> ns({.method = method, .subdivision = a.subdivision});
+  NeighborSearch<Dim, Real> ns(
+      {.method = method, .subdivision = a.subdivision, .hash_table_size = 0, .sorted_rows = !a.unsorted_rows});
   if (table.has_h())
     ns.build(x, std::span<const Real>(table.h));
   else
@@ -161,6 +163,9 @@ void register_neighbors(CLI::App& app, int& result) {
   auto* threads = sub->add_option("--threads", args->threads, "threads (>= 1; default: all cores)");
   sub->add_flag("--counts", args->counts, "write i,count (neighbours per particle) instead of i,j pairs");
   sub->add_flag("--stats", args->stats, "print one line of search statistics to stderr");
+  sub->add_flag("--unsorted-rows", args->unsorted_rows,
+                "cell-index lists each particle's neighbours in its own order (the same for the same input) "
+                "instead of ascending, and skips sorting them; other methods list them ascending");
   sub->add_option("--output", args->output, "output CSV (written atomically)")->required()->type_name("FILE");
   sub->callback([args, radius, threads, &result] {
     args->radius_given = radius->count() > 0;

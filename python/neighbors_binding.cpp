@@ -137,9 +137,18 @@ auto dispatch(const Query& q, F&& f) {
   return q.f32 ? f.template operator()<3, float>() : f.template operator()<3, double>();
 }
 
+// sort_rows = false: Cell Indexing leaves each row in its own order (SearchOptions::sorted_rows).
+SearchOptions search_options(const std::string& method, int subdivision, bool sort_rows = true) {
+  return {.method = method_arg(method),
+          .subdivision = subdivision_arg(subdivision),
+          .hash_table_size = 0,
+          .sorted_rows = sort_rows};
+}
+
 py::tuple neighbors_fn(const py::handle& points, std::optional<double> radius, const py::handle& h,
-                       const std::string& method, int threads, int subdivision, bool return_distances) {
-  const SearchOptions opt{.method = method_arg(method), .subdivision = subdivision_arg(subdivision)};
+                       const std::string& method, int threads, int subdivision, bool return_distances,
+                       bool sort_rows) {
+  const SearchOptions opt = search_options(method, subdivision, sort_rows);
   check_threads(threads);
   const Query q = query_args(points, radius, h);
   return dispatch(q, [&]<int Dim, class Real>() {
@@ -151,7 +160,7 @@ py::tuple neighbors_fn(const py::handle& points, std::optional<double> radius, c
 
 py::array count_fn(const py::handle& points, std::optional<double> radius, const py::handle& h,
                    const std::string& method, int threads, int subdivision) {
-  const SearchOptions opt{.method = method_arg(method), .subdivision = subdivision_arg(subdivision)};
+  const SearchOptions opt = search_options(method, subdivision);
   check_threads(threads);
   const Query q = query_args(points, radius, h);
   return dispatch(q, [&]<int Dim, class Real>() {
@@ -166,9 +175,8 @@ py::array count_fn(const py::handle& points, std::optional<double> radius, const
 // (some methods read the points again in find_all).
 class PyNeighborSearch {
  public:
-  PyNeighborSearch(const std::string& method, int subdivision, int threads)
-      : opt_{.method = method_arg(method), .subdivision = subdivision_arg(subdivision)},
-        threads_(check_threads(threads)) {}
+  PyNeighborSearch(const std::string& method, int subdivision, int threads, bool sort_rows)
+      : opt_(search_options(method, subdivision, sort_rows)), threads_(check_threads(threads)) {}
 
   void build(const py::handle& points, std::optional<double> radius, const py::handle& h) {
     Query q = query_args(points, radius, h);
@@ -215,6 +223,7 @@ class PyNeighborSearch {
 
   [[nodiscard]] std::string method() const { return std::string(method_name(opt_.method)); }
   [[nodiscard]] int subdivision() const { return opt_.subdivision; }
+  [[nodiscard]] bool sort_rows() const { return opt_.sorted_rows; }
   [[nodiscard]] int threads() const { return threads_; }
   [[nodiscard]] std::size_t size() const { return built_ ? q_.n : 0; }
   [[nodiscard]] py::object dim() const {
@@ -262,12 +271,16 @@ subdivision : int
     Cell Indexing / grid subdivision factor H >= 1 (cells of size h / H).
 return_distances : bool
     Also return the distance of each listed pair (points' dtype).
+sort_rows : bool
+    True (default): every row ascending, the same arrays whatever the method or the thread count.
+    False: "cell-index" leaves each row in its own order (cell by cell, the same for the same points,
+    method and subdivision) and skips sorting it; the other methods' rows stay ascending.
 
 Returns
 -------
 offsets : ndarray of int64, shape (n + 1,)
 indices : ndarray of uint32
-    Neighbours of i are indices[offsets[i]:offsets[i + 1]], sorted ascending.
+    Neighbours of i are indices[offsets[i]:offsets[i + 1]], ascending unless sort_rows=False.
 distances : ndarray, only with return_distances=True
     Aligned with indices.
 
@@ -279,7 +292,8 @@ Raises ValueError naming the argument for wrong shapes, dtypes, non-finite value
 void register_neighbors(py::module_& m) {
   using namespace pybind11::literals;
   m.def("neighbors", &neighbors_fn, kNeighborsDoc, "points"_a, "radius"_a = py::none(), "h"_a = py::none(),
-        "method"_a = "cell-index", "threads"_a = 0, "subdivision"_a = 1, "return_distances"_a = false);
+        "method"_a = "cell-index", "threads"_a = 0, "subdivision"_a = 1, "return_distances"_a = false,
+        "sort_rows"_a = true);
   m.def("count_neighbors", &count_fn,
         "The number of neighbours of every point (int64, shape (n,)), without building the lists.\n\n"
         "Same arguments and neighbour relation as neighbors().",
@@ -304,19 +318,22 @@ void register_neighbors(py::module_& m) {
 
 find_all() and count() read the arrays given to the last build(): call build() again after changing them.
 One search at a time per object (calls from several Python threads wait for each other).)doc")
-      .def(py::init<const std::string&, int, int>(), "method"_a = "cell-index", "subdivision"_a = 1,
-           "threads"_a = 0)
+      .def(py::init<const std::string&, int, int, bool>(), "method"_a = "cell-index", "subdivision"_a = 1,
+           "threads"_a = 0, "sort_rows"_a = true)
       .def("build", &PyNeighborSearch::build,
            "Builds the structure for points (n, 2|3) float32/float64 with one radius or per-point h.",
            "points"_a, "radius"_a = py::none(), "h"_a = py::none())
       .def("find_all", &PyNeighborSearch::find_all,
-           "(offsets int64, indices uint32[, distances]) of the last build; rows sorted ascending.",
+           "(offsets int64, indices uint32[, distances]) of the last build; rows ascending unless the "
+           "search was made with sort_rows=False.",
            "return_distances"_a = false)
       .def("count", &PyNeighborSearch::count_all, "Neighbours per point (int64) of the last build.")
       .def_property_readonly("stats", &PyNeighborSearch::stats,
                              "The last build/find_all: build_ms, query_ms, pairs, candidates, memory_bytes.")
       .def_property_readonly("method", &PyNeighborSearch::method, "The search method's name.")
       .def_property_readonly("subdivision", &PyNeighborSearch::subdivision, "The subdivision factor H.")
+      .def_property_readonly("sort_rows", &PyNeighborSearch::sort_rows,
+                             "False: cell-index leaves each row in its own order (see neighbors()).")
       .def_property_readonly("threads", &PyNeighborSearch::threads, "OpenMP threads (0 = all cores).")
       .def_property_readonly("size", &PyNeighborSearch::size, "Points of the last build (0 before).")
       .def_property_readonly("dim", &PyNeighborSearch::dim, "2 or 3 (None before the first build).")

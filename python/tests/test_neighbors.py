@@ -106,6 +106,27 @@ def test_thread_counts_give_the_same_arrays():
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
 
 
+def test_unsorted_rows_hold_the_reference_sets_in_the_searchs_order():
+    points = random_set(20000, 3, np.float64, seed=12)
+    ref = reference_rows(points, 0.04)
+    a = cellsph.neighbors(points, radius=0.04, sort_rows=False, threads=1)
+    b = cellsph.neighbors(points, radius=0.04, sort_rows=False, threads=2, return_distances=True)
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])  # the order is the search's, not the threads'
+    rows = rows_of(a[0], a[1])
+    assert any(row != sorted(row) for row in rows)  # the option reached the search
+    assert [sorted(row) for row in rows] == ref
+    r = np.repeat(np.arange(len(points)), np.diff(b[0]))
+    np.testing.assert_allclose(b[2], np.linalg.norm(points[r] - points[b[1]], axis=1), rtol=1e-14)
+    # The reusable object keeps the option; another method's rows stay ascending.
+    ns = cellsph.NeighborSearch(sort_rows=False)
+    assert ns.sort_rows is False and cellsph.NeighborSearch().sort_rows is True
+    ns.build(points, radius=0.04)
+    offsets, indices = ns.find_all()
+    assert np.array_equal(offsets, a[0]) and np.array_equal(indices, a[1])
+    kd = cellsph.neighbors(points, radius=0.04, method="kd-tree", sort_rows=False)
+    assert rows_of(*kd) == ref
+
+
 def test_count_neighbors_and_distances():
     points = random_set(2000, 2, np.float64, seed=6)
     offsets, indices, dist = cellsph.neighbors(points, radius=0.05, return_distances=True)
