@@ -421,9 +421,9 @@ TEST(NeighborsCli, UnsortedRowsHoldTheSamePairsInTheSearchsOrder) {
   };
   std::string outputs[2];
   for (int t = 1; t <= 2; ++t) {
-    const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
-                                    " --radius 1.25 --unsorted-rows --threads " + std::to_string(t) +
-                                    " --output " + q(dir / "out.csv"));
+    const auto r =
+        run_cli(dir, "neighbors --input " + q(dir / "in.csv") + " --radius 1.25 --unsorted-rows --threads " +
+                         std::to_string(t) + " --output " + q(dir / "out.csv"));
     ASSERT_EQ(r.code, 0) << r.err;
     outputs[t - 1] = read_file(dir / "out.csv");
   }
@@ -438,8 +438,9 @@ TEST(NeighborsCli, UnsortedRowsHoldTheSamePairsInTheSearchsOrder) {
     ASSERT_EQ(rows[i], expected[i]) << "row " << i;
   }
   EXPECT_TRUE(some_unsorted) << "every row came out ascending: --unsorted-rows did not reach the search";
-  const auto r = run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
-                                  " --radius 1.25 --unsorted-rows --method kd-tree --output " + q(dir / "kd.csv"));
+  const auto r =
+      run_cli(dir, "neighbors --input " + q(dir / "in.csv") +
+                       " --radius 1.25 --unsorted-rows --method kd-tree --output " + q(dir / "kd.csv"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(read_file(dir / "kd.csv"), expected_pairs_csv(expected));
 }

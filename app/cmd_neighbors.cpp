@@ -83,7 +83,7 @@ void run(const NeighborsArgs& a, double radius, Method method, const PointsTable
   using Real = double;
   const auto x = table.points<Dim, Real>();
   NeighborSearch<Dim, Real> ns(
-      {.method = method, .subdivision = a.subdivision, .hash_table_size = 0, .sorted_rows = !a.unsorted_rows});
+      {.method = method, .subdivision = a.subdivision, .sorted_rows = !a.unsorted_rows});
   if (table.has_h())
     ns.build(x, std::span<const Real>(table.h));
   else

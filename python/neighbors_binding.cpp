@@ -139,10 +139,8 @@ auto dispatch(const Query& q, F&& f) {
 
 // sort_rows = false: Cell Indexing leaves each row in its own order (SearchOptions::sorted_rows).
 SearchOptions search_options(const std::string& method, int subdivision, bool sort_rows = true) {
-  return {.method = method_arg(method),
-          .subdivision = subdivision_arg(subdivision),
-          .hash_table_size = 0,
-          .sorted_rows = sort_rows};
+  return {
+      .method = method_arg(method), .subdivision = subdivision_arg(subdivision), .sorted_rows = sort_rows};
 }
 
 py::tuple neighbors_fn(const py::handle& points, std::optional<double> radius, const py::handle& h,

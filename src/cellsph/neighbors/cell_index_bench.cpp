@@ -47,7 +47,6 @@ void BM_CellIndexBuildAndLists(benchmark::State& state) {
   const std::vector<float> h(x.size(), 2.0f);
   CellIndex<3, float> ci({.method = Method::CellIndex,
                           .subdivision = static_cast<int>(state.range(0)),
-                          .hash_table_size = 0,
                           .sorted_rows = state.range(2) != 0});
   NeighborList nl;
   double build_ms = 0, query_ms = 0;
