@@ -530,6 +530,11 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     d.min_iterations = static_cast<int>(dr.integer("min_iterations", d.min_iterations, 0, 100000));
     d.max_iterations = static_cast<int>(dr.integer("max_iterations", d.max_iterations, 1, 100000));
     d.warm_start = dr.boolean("warm_start", d.warm_start);
+    d.warm_start_scale =
+        static_cast<Real>(dr.number("warm_start_scale", double(d.warm_start_scale), 1e-9, 1));
+    d.density_solver = dr.choice("density_solver", "jacobi", {"jacobi", "cg"}) == "cg"
+                           ? DfsphDensitySolver::ConjugateGradient
+                           : DfsphDensitySolver::Jacobi;
     const std::string wall_pressure = dr.choice("wall_pressure", "zero", {"zero", "mirrored", "hydrostatic"});
     d.wall_pressure = wall_pressure == "zero"       ? DfsphWallPressure::Zero
                       : wall_pressure == "mirrored" ? DfsphWallPressure::Mirrored

@@ -96,6 +96,15 @@ void SolverConfig<Dim, Real>::validate() const {
     if (dfsph.min_iterations > dfsph.max_iterations)
       bad("dfsph.min_iterations", dfsph.min_iterations,
           ("must not exceed dfsph.max_iterations = " + std::to_string(dfsph.max_iterations)).c_str());
+    if (!(dfsph.warm_start_scale > 0 && dfsph.warm_start_scale <= 1))
+      bad("dfsph.warm_start_scale", dfsph.warm_start_scale, "must be in (0, 1]");
+    // Several phases: the number density's system is not symmetric in k (its pair force weighs m_i^2 k_i
+    // and m_j^2 k_j), which CG needs.
+    if (dfsph.density_solver == DfsphDensitySolver::ConjugateGradient &&
+        density == DensityFormulation::Number)
+      bad("dfsph.density_solver", "cg",
+          "the conjugate-gradient solve needs the mass density of one phase; several phases (density = "
+          "number) take \"jacobi\"");
     // Adami and dynamic walls take their pressure from the fluid's (extrapolated) or from an equation of
     // state; neither is an unknown of the DFSPH solves, so the factor alpha_i would not describe what a
     // sweep changes (docs/physics.md, "DFSPH").

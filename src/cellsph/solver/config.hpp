@@ -66,6 +66,12 @@ enum class DfsphWallPressure {
   Hydrostatic,  // "hydrostatic": the fluid particle's own plus rho_i (g - a_b) . (x_b - x_i)
 };
 
+// DFSPH's constant-density solve (SolverConfig::Dfsph::density_solver).
+enum class DfsphDensitySolver {
+  Jacobi,             // "jacobi": the sweeps of Bender & Koschier (models/dfsph.hpp)
+  ConjugateGradient,  // "cg": preconditioned CG on the active set (models/dfsph_cg.hpp)
+};
+
 enum class TimeStepping {
   Fixed,    // dt = time.dt every step (the paper's test)
   Courant,  // global dt = min over particles of eq. 12, the viscous and the force limit, at most dt_max
@@ -220,6 +226,11 @@ struct SolverConfig {
     int min_iterations = 2;
     int max_iterations = 100;
     bool warm_start = true;
+    // The share of the last step's k the constant-density solve starts from (with warm_start; the
+    // divergence solve keeps 0.5). 0.5, as SPlisHSPlasH: the Jacobi sweeps only add pressure, so a larger
+    // share that overshoots stays for the step; the CG solve takes pressure back (docs/physics.md).
+    Real warm_start_scale = Real(0.5);
+    DfsphDensitySolver density_solver = DfsphDensitySolver::Jacobi;
     // A wall particle's pressure in the pressure force (`wall_pressure`): 0 ("zero", Akinci 2012 as
     // SPlisHSPlasH: the fluid row next to a wall then carries the column on half the terms, and its
     // pressure is ~1.8x rho0 g d); the fluid particle's own ("mirrored": extrapolated at zeroth order, that

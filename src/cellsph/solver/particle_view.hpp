@@ -63,6 +63,11 @@ struct ParticleView {
   V* df_gwall = nullptr;          // DFSPH: its walls' part, sum_b w_ib grad W_ib
   V* df_mv = nullptr;             // DFSPH: w_j v_j (the mass density's sweeps gather it)
   Real* df_mk = nullptr;          // DFSPH: m_j k_j of the sweep, 0 for a wall
+  V* cg_v0 = nullptr;             // DFSPH's CG density solve (models/dfsph_cg.hpp): v before the kick by p
+  Real* cg_s = nullptr;           // DFSPH CG: the predicted density error s_i (signed)
+  Real* cg_p = nullptr;           // DFSPH CG: the search direction
+  Real* cg_ap = nullptr;          // DFSPH CG: (A p)_i
+  std::uint8_t* cg_active = nullptr;  // DFSPH CG: 1 in the active set
 
   // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +
   // 1]. The rows cut to h (filter_rows): within + offsets[i], within_count[i] long; the pair passes read

@@ -313,6 +313,11 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.df_gwall = df_gwall_.data();
   v.df_mv = df_mv_.data();
   v.df_mk = df_mk_.data();
+  v.cg_v0 = cg_v0_.data();
+  v.cg_s = cg_s_.data();
+  v.cg_p = cg_p_.data();
+  v.cg_ap = cg_ap_.data();
+  v.cg_active = cg_active_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
   v.within = within_.data();
@@ -703,6 +708,13 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
   df_gwall_.resize(n);
   df_mv_.resize(n);
   df_mk_.resize(n);
+  if (cfg_.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient) {
+    cg_v0_.resize(n);
+    cg_s_.resize(n);
+    cg_p_.resize(n);
+    cg_ap_.resize(n);
+    cg_active_.resize(n);
+  }
   if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
   const Real dt = dfsph_step(cfg_, view(), fluid_, n, df_diameter_, dfsph_stats_, steps_ + 1);
   timings_.forces += sw.ms();

@@ -323,6 +323,9 @@ class Simulation {
   std::vector<Real> df_grad_;
   std::vector<V> df_gsum_, df_gwall_, df_mv_;  // DFSPH: per-step sums and the sweeps' gathered w_j v_j
   std::vector<Real> df_mk_;                    // DFSPH: the sweeps' gathered m_j k_j
+  std::vector<V> cg_v0_;                       // DFSPH's CG density solve (models/dfsph_cg.hpp)
+  std::vector<Real> cg_s_, cg_p_, cg_ap_;
+  std::vector<std::uint8_t> cg_active_;
   Real df_diameter_ = 0;
   DfsphStats dfsph_stats_;
 

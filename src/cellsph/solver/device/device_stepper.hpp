@@ -237,6 +237,11 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.df_gwall = df_gwall_.data();
     v.df_mv = df_mv_.data();
     v.df_mk = df_mk_.data();
+    v.cg_v0 = cg_v0_.data();
+    v.cg_s = cg_s_.data();
+    v.cg_p = cg_p_.data();
+    v.cg_ap = cg_ap_.data();
+    v.cg_active = cg_active_.data();
     v.offsets = offsets_.data();
     v.candidates = rows_.data();
     v.within = rows_.data();
@@ -307,6 +312,13 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     df_gwall_.resize(n_);
     df_mv_.resize(n_);
     df_mk_.resize(n_);
+    if (cfg_.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient) {
+      cg_v0_.resize(n_);
+      cg_s_.resize(n_);
+      cg_p_.resize(n_);
+      cg_ap_.resize(n_);
+      cg_active_.resize(n_);
+    }
     return dfsph_step(cfg_, view(), fluid, DeviceRange<Space>{n_}, in.dfsph_diameter, *in.dfsph, in.step);
   }
 
@@ -440,6 +452,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
   Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_grad_, df_mk_;  // DFSPH (models/dfsph.hpp)
   Array<V> df_gsum_, df_gwall_, df_mv_;
+  Array<Real> cg_s_, cg_p_, cg_ap_;  // DFSPH's CG density solve (models/dfsph_cg.hpp)
+  Array<V> cg_v0_;
+  Array<std::uint8_t> cg_active_;
   Array<V> f_pressure_, wall_v_, normal_;
   // Moving walls: the config's motions and table rows; per moving wall its slot, initial position, motion;
   // every particle's wall acceleration (empty when nothing moves).

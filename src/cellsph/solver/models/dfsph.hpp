@@ -17,7 +17,8 @@
 // v_i by -dt sum_j m_j (k_i + k_j) grad W_ij - dt sum_b psi_b k_i grad W_ib (symmetric_pressure_force with
 // the wall's k = 0: the gradient of i's density constraint, so alpha_i is exactly the Jacobi diagonal).
 // Warm starts (2017 paper): each solve begins with half of the last step's k where the particle is
-// compressed.
+// compressed (the density solve: dfsph.warm_start_scale of it). The density solve may instead be the
+// conjugate-gradient one of models/dfsph_cg.hpp (dfsph.density_solver = cg).
 // The sweeps of the mass density (one phase) gather two arrays a pair, not three or four: with the step's
 // G_i = sum_j w_ij grad W_ij (df_gsum, from the density pass), D rho_i / Dt = v_i . G_i - sum_j (w_j v_j) .
 // grad W_ij and the kick -dt (k_i G_i + sum_j (m_j k_j) grad W_ij), with w_j v_j (df_mv) kept by every pass
@@ -257,8 +258,8 @@ struct DfsphPressureKickPass {
     using V = Vec<Dim, Real>;
     const Real mi = pv.m[i], ki = pv.df_kappa[i];
     const V xi = pv.x[i];
-    acc[i] += ki;
-    if (!number) {  // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
+    if (acc) acc[i] += ki;  // null: a kick that is not part of the solve's sum (models/dfsph_cg.hpp)
+    if (!number) {          // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
       V s = (mirror ? V(pv.df_gsum[i] + pv.df_gwall[i]) : pv.df_gsum[i]) * ki;
       for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
         s += dfsph_grad(pv, xi, it) * pv.df_mk[*it];
@@ -345,12 +346,17 @@ struct DfsphSolveResult {
   double error = 0;  // relative (not percent)
 };
 
-// The warm start's rule: half the last step's k, as SPlisHSPlasH (the full sum, measured, set the
-// hydrostatic column and the dam break ringing).
+// The divergence solve's warm start: half the last step's k, as SPlisHSPlasH (the full sum, measured, set
+// the hydrostatic column and the dam break ringing). The density solve's is dfsph.warm_start_scale (0.5
+// by default).
 template <class Real>
-DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool warm_start,
+inline constexpr Real kDfsphDivergenceWarmScale = Real(0.5);
+
+// The warm start's rule: warm_scale times the last step's k where the particle is compressed.
+template <class Real>
+DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool warm_start, Real warm_scale,
                                       std::uint32_t min_neighbors) {
-  return {dt, density, true, Real(warm_start ? 0.5 : 0.0), acc, min_neighbors};
+  return {dt, density, true, warm_start ? warm_scale : Real(0), acc, min_neighbors};
 }
 
 // One solve (density or divergence): warm start, then sweeps until the average error is at most eta
@@ -359,11 +365,13 @@ DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool war
 template <int Dim, class Real, class Kernel, class Set>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
-                             std::uint32_t min_neighbors, bool number, bool mirror, bool warm_k_set = false) {
+                             Real warm_scale, std::uint32_t min_neighbors, bool number, bool mirror,
+                             bool warm_k_set = false) {
   const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number, mirror};
   if (!warm_k_set)
-    run_pass(set, DfsphSourcePass<Dim, Real, Kernel>{
-                      pv, w, dfsph_warm_rule(dt, density, acc, warm_start, min_neighbors), number});
+    run_pass(set,
+             DfsphSourcePass<Dim, Real, Kernel>{
+                 pv, w, dfsph_warm_rule(dt, density, acc, warm_start, warm_scale, min_neighbors), number});
   if (warm_start) run_pass(set, kick);
   const DfsphSourcePass<Dim, Real, Kernel> source{
       pv, w, DfsphSourceRule<Real>{dt, density, false, Real(0), acc, min_neighbors}, number};
@@ -418,7 +426,8 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
     run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{
                         pv, w, denom_floor, number, mirror,
-                        dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start, min_neighbors)});
+                        dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start,
+                                        kDfsphDivergenceWarmScale<Real>, min_neighbors)});
     // The step from the velocities at its start.
     if (cfg.time.mode == TimeStepping::Fixed) {
       dt = cfg.time.dt;
@@ -447,9 +456,9 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
         st.last_hit_error = r.error * 100;
       }
     };
-    const DfsphSolveResult div =
-        dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
-                    cfg.dfsph.warm_start, min_neighbors, number, mirror, !number);
+    const DfsphSolveResult div = dfsph_solve(
+        pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
+        cfg.dfsph.warm_start, kDfsphDivergenceWarmScale<Real>, min_neighbors, number, mirror, !number);
     check(div, eta_divergence, "divergence-free");
     st.ms_divergence += sw.ms();
     sw.reset();
@@ -462,8 +471,13 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     sw.reset();
 
     const DfsphSolveResult den =
-        dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
-                    cfg.dfsph.max_iterations, cfg.dfsph.warm_start, min_neighbors, number, mirror);
+        cfg.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient
+            ? dfsph_solve_cg(pv, fluid, w, dt, pv.prho2, eta_density, cfg.dfsph.min_iterations,
+                             cfg.dfsph.max_iterations,
+                             cfg.dfsph.warm_start ? cfg.dfsph.warm_start_scale : Real(0), mirror)
+            : dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
+                          cfg.dfsph.max_iterations, cfg.dfsph.warm_start, cfg.dfsph.warm_start_scale,
+                          min_neighbors, number, mirror);
     check(den, eta_density, "constant-density");
     st.ms_density += sw.ms();
     sw.reset();
@@ -484,3 +498,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
 }
 
 }  // namespace cellsph
+
+// The CG density solve that dfsph_step calls when dfsph.density_solver is "cg" (it builds on the passes
+// above).
+#include "cellsph/solver/models/dfsph_cg.hpp"  // IWYU pragma: export
