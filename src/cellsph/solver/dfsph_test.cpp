@@ -1,6 +1,7 @@
 // DFSPH (models/dfsph.hpp): the hydrostatic column against rho g d, a 2D dam break at the CFL steps
 // against the tank walls, the solvers' stopping rule, bit-identity across runs, thread counts and
-// neighbour methods, float and 3D, and the validation of its keys.
+// neighbour methods, float and 3D, the conjugate-gradient density solve (models/dfsph_cg.hpp), and the
+// validation of its keys.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -53,11 +54,16 @@ struct ColumnRun {
   double p_mid = 0, p_bot = 0, max_error = 0, kinetic = 0, kinetic_bound = 0;
   std::uint64_t hits = 0;
   double dt = 0;
+  double sweeps = 0;  // density iterations a step after settling
 };
 
-ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool hydrostatic = false) {
+// `cg`: the conjugate-gradient density solve (models/dfsph_cg.hpp) from warm_scale of the last k.
+ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool hydrostatic = false,
+                        bool cg = false, double warm_scale = 0.5) {
   const double s = 0.02, W = 0.4, H = 0.4, rho0 = 1000, g = 9.81;
   auto cfg = dfsph_water<2, double>(s, 5.0, dt_max);
+  if (cg) cfg.dfsph.density_solver = DfsphDensitySolver::ConjugateGradient;
+  cfg.dfsph.warm_start_scale = warm_scale;
   cfg.dfsph.wall_pressure = hydrostatic ? DfsphWallPressure::Hydrostatic
                             : mirror    ? DfsphWallPressure::Mirrored
                                         : DfsphWallPressure::Zero;
@@ -70,7 +76,8 @@ ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool 
   ScopedThreads one(1);  // 400 particles: thread start-up would dominate
   Simulation<2, double> sim(cfg, p);
   sim.run_until(1.0);
-  const auto hits_settling = sim.dfsph_stats().max_iteration_hits;
+  const auto settled = sim.dfsph_stats();
+  const auto hits_settling = settled.max_iteration_hits;
   double p_mid = 0, ref_mid = 0, p_bot = 0, ref_bot = 0;
   ColumnRun r;
   while (sim.time() < 2.0) {
@@ -96,11 +103,13 @@ ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool 
   r.p_mid = p_mid / ref_mid;
   r.p_bot = p_bot / ref_bot;
   r.hits = sim.dfsph_stats().max_iteration_hits - hits_settling;
+  r.sweeps = double(sim.dfsph_stats().density_iterations - settled.density_iterations) /
+             double(sim.dfsph_stats().steps - settled.steps);
   r.kinetic = sim.kinetic_energy();
   r.kinetic_bound = 1e-3 * sim.total_mass() * g * H;
   r.dt = sim.last_dt();
   const auto& st = sim.dfsph_stats();
-  std::cout << "[dfsph hydrostatic] walls "
+  std::cout << "[dfsph hydrostatic] " << (cg ? "cg" : "jacobi") << " walls "
             << (hydrostatic ? "hydrostatic"
                 : mirror    ? "mirrored"
                             : "zero")
@@ -394,6 +403,71 @@ TEST(Dfsph, SmallColumn2DFloat) {
   settle_small_column<2, float>();
 }
 
+// The conjugate-gradient density solve (models/dfsph_cg.hpp) on the deep column, where Jacobi is slow (the
+// pressure reaches the bottom one row a sweep): at 8 ms steps with hydrostatic walls, started from 0.85 of
+// the last step's pressure, it meets the bound in less than half the iterations, stops at max_iterations
+// no more often, and gives rho0 g d in the lower half and the bottom row.
+TEST(Dfsph, CgDensitySolveTakesTheDeepColumnInFewerIterations) {
+  const ColumnRun jacobi = settle_column(true, 0.008, false, true);
+  const ColumnRun cg = settle_column(true, 0.008, false, true, true, 0.85);
+  EXPECT_LT(cg.sweeps, 0.5 * jacobi.sweeps);
+  EXPECT_LE(cg.hits, jacobi.hits);
+  EXPECT_NEAR(cg.p_mid, 1.0, 0.05);
+  EXPECT_NEAR(cg.p_bot, 1.0, 0.05);
+  EXPECT_LT(cg.kinetic, cg.kinetic_bound) << "the column should settle";
+}
+
+// The CG solve on the 2D dam break: no particle out of the tank through the impact, every solve within its
+// rules, no negative pressure (k is clamped at 0); the same bits for one and two threads, on the
+// host-emulated device and through a checkpoint; and not the Jacobi bits.
+TEST(Dfsph, CgDensitySolveHoldsTheDamBreakAndItsBits) {
+  auto d = dam_break(Method::CellIndex);
+  d.cfg.dfsph.density_solver = DfsphDensitySolver::ConjugateGradient;
+  d.cfg.dfsph.warm_start_scale = 0.85;
+  {
+    Simulation<2, double> sim(d.cfg, d.particles);
+    double vmax = 0;
+    while (sim.time() < 1.0) {
+      sim.step();
+      expect_solver_rules(sim, "step " + std::to_string(sim.steps()));
+      const auto& q = sim.particles();
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        if (q.kind[i] != 0) continue;
+        vmax = std::max(vmax, norm(q.v[i]));
+        ASSERT_TRUE(q.x[i][0] >= 0 && q.x[i][0] <= DamBreak::L && q.x[i][1] >= 0 && q.x[i][1] <= DamBreak::Ht)
+            << "fluid particle " << i << " outside the tank after step " << sim.steps();
+        ASSERT_GE(q.p[i], 0) << "particle " << i << ", step " << sim.steps();
+      }
+    }
+    EXPECT_GT(vmax, 2.0) << "the front should have hit the far wall";
+    const auto& st = sim.dfsph_stats();
+    std::cout << "[dfsph cg dam break] steps " << sim.steps() << " density iterations/step "
+              << double(st.density_iterations) / double(st.steps) << " max density error "
+              << st.max_density_error << "% max-iteration hits " << st.max_iteration_hits << "\n";
+  }
+  auto run = [&](int threads, Backend backend) {
+    ScopedThreads t(threads);
+    Simulation<2, double> sim(d.cfg, d.particles);
+    sim.use_backend(backend);
+    for (int k = 0; k < 40; ++k) sim.step();
+    return sim.particles();
+  };
+  const auto a = run(2, Backend::Cpu);
+  EXPECT_TRUE(test::same_state(a, run(1, Backend::Cpu))) << "one thread";
+  EXPECT_TRUE(test::same_state(a, run(2, Backend::HostDevice))) << "host device";
+  Simulation<2, double> first(d.cfg, d.particles);
+  for (int k = 0; k < 20; ++k) first.step();
+  Simulation<2, double> resumed(d.cfg, d.particles);
+  resumed.restore(first.particles(), first.integrator_state(), "checkpoint", first.solver_state());
+  for (int k = 20; k < 40; ++k) resumed.step();
+  EXPECT_TRUE(test::same_state(resumed.particles(), a)) << "resumed";
+  auto jacobi = d.cfg;
+  jacobi.dfsph.density_solver = DfsphDensitySolver::Jacobi;
+  Simulation<2, double> j(jacobi, d.particles);
+  for (int k = 0; k < 40; ++k) j.step();
+  EXPECT_FALSE(test::same_state(a, j.particles())) << "the CG solve gave the Jacobi bits";
+}
+
 // The device step (the host-emulated device: the CUDA backend's code path over host memory) gives the CPU's
 // bits, solver statistics included, and its divergence warm start travels with a checkpoint: a run started
 // on the device resumes on the CPU as if uninterrupted.
@@ -470,6 +544,15 @@ TEST(Dfsph, BadSettingsAreInputErrors) {
         c.dfsph.max_iterations = 4;
       },
       "dfsph.min_iterations = 5");
+  expect_error([](C& c) { c.dfsph.warm_start_scale = 0; }, "dfsph.warm_start_scale = 0");
+  expect_error([](C& c) { c.dfsph.warm_start_scale = 1.5; }, "dfsph.warm_start_scale = 1.5");
+  // CG needs a symmetric system: one phase's mass density.
+  expect_error(
+      [](C& c) {
+        c.dfsph.density_solver = DfsphDensitySolver::ConjugateGradient;
+        c.density = DensityFormulation::Number;
+      },
+      "dfsph.density_solver = cg");
   expect_error([](C& c) { c.wall_model = WallModel::Adami; }, "boundary.model = adami");
   expect_error([](C& c) { c.wall_model = WallModel::Dynamic; }, "boundary.model = dynamic");
   expect_error([](C& c) { c.phases[0].sigma = 0.07; }, "phases[0].sigma = 0.07");
@@ -505,6 +588,7 @@ TEST(Dfsph, SceneKeys) {
                                      "min_iterations": 3, "max_iterations": 50, "warm_start": false,
                                      "wall_pressure": "hydrostatic"})"),
             "");
+  EXPECT_EQ(scene_error("dfsph", R"({"density_solver": "cg", "warm_start_scale": 0.85})"), "");
   const std::pair<std::string, std::string> bad[] = {
       {R"({"max_density_error": 0})", "/solver/dfsph/max_density_error"},
       {R"({"max_divergence_error": -0.1})", "/solver/dfsph/max_divergence_error"},
@@ -512,7 +596,10 @@ TEST(Dfsph, SceneKeys) {
       {R"({"min_iterations": 9, "max_iterations": 4})", "/solver/dfsph/min_iterations"},
       {R"({"max_iterations": 4.5})", "/solver/dfsph/max_iterations"},
       {R"({"warmstart": true})", "/solver/dfsph/warmstart"},
-      {R"({"wall_pressure": "extrapolated"})", "/solver/dfsph/wall_pressure"}};
+      {R"({"wall_pressure": "extrapolated"})", "/solver/dfsph/wall_pressure"},
+      {R"({"density_solver": "gmres"})", "/solver/dfsph/density_solver"},
+      {R"({"warm_start_scale": 2})", "/solver/dfsph/warm_start_scale"},
+      {R"({"warm_start_scale": 0})", "/solver/dfsph/warm_start_scale"}};
   for (const auto& [value, key] : bad) {
     const std::string msg = scene_error("dfsph", value);
     EXPECT_NE(msg.find(key), std::string::npos) << value << " -> " << msg;
