@@ -44,12 +44,11 @@ void expect_solver_rules(const Simulation<Dim, Real>& sim, const std::string& wh
   }
 }
 
-// A column of water W x H at rest in an open tank of two layers of wall particles weighted like the fluid
-// (rho0 s^2, so the lattice starts at rest density), stepped at dt_max after settling for 1 s; over the
-// next second, the solver's pressure against rho0 g d summed over the lower half above the bottom row and
-// over the bottom row, the largest density error, the solves stopped at max_iterations and the kinetic
-// energy at the end. dt_max = 5 ms is 11.6x the WCSPH Courant step of the same resolution (0.3 h /
-// (10 sqrt(2 g H)) = 0.43 ms).
+// The column of test::DfsphColumn (0.4 x 0.4 m of water at spacing 0.02 m, mu = 5 Pa s unless a case says
+// otherwise) at rest, stepped at dt_max after settling for 1 s; over the next second, the solver's pressure
+// against rho0 g d summed over the lower half above the bottom row and over the bottom row, the largest
+// density error, the solves stopped at max_iterations and the kinetic energy at the end. dt_max = 5 ms is
+// 11.6x the WCSPH Courant step of the same resolution (0.3 h / (10 sqrt(2 g H)) = 0.43 ms at h = 2 s).
 struct ColumnRun {
   double p_mid = 0, p_bot = 0, max_error = 0, kinetic = 0, kinetic_bound = 0;
   std::uint64_t hits = 0;
@@ -57,24 +56,22 @@ struct ColumnRun {
   double sweeps = 0;  // density iterations a step after settling
 };
 
+test::DfsphColumn column(DfsphWallPressure walls, double dt_max) {
+  test::DfsphColumn c;
+  c.walls = walls;
+  c.dt_max = dt_max;
+  return c;
+}
+
 // `cg`: the conjugate-gradient density solve (models/dfsph_cg.hpp) from warm_scale of the last k.
-ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool hydrostatic = false,
-                        bool cg = false, double warm_scale = 0.5) {
-  const double s = 0.02, W = 0.4, H = 0.4, rho0 = 1000, g = 9.81;
-  auto cfg = dfsph_water<2, double>(s, 5.0, dt_max);
+ColumnRun settle_column(const test::DfsphColumn& c, bool check_every_step, bool cg = false,
+                        double warm_scale = 0.5) {
+  const double s = c.s, H = c.depth, rho0 = c.rho0, g = c.g;
+  auto cfg = c.config();
   if (cg) cfg.dfsph.density_solver = DfsphDensitySolver::ConjugateGradient;
   cfg.dfsph.warm_start_scale = warm_scale;
-  cfg.dfsph.wall_pressure = hydrostatic ? DfsphWallPressure::Hydrostatic
-                            : mirror    ? DfsphWallPressure::Mirrored
-                                        : DfsphWallPressure::Zero;
-  cfg.domain_set = true;
-  cfg.domain_lo = V2{{-0.1, -0.1}};
-  cfg.domain_hi = V2{{W + 0.1, 2 * H}};
-  Particles<2, double> p;
-  add_block<2, double>(p, V2{{0, 0}}, V2{{W, H}}, s, 0);
-  add_box_walls<2, double>(p, V2{{0, 0}}, V2{{W, H + 2 * s}}, s, 2, true, 0, rho0 * s * s);
   ScopedThreads one(1);  // 400 particles: thread start-up would dominate
-  Simulation<2, double> sim(cfg, p);
+  Simulation<2, double> sim(cfg, c.particles());
   sim.run_until(1.0);
   const auto settled = sim.dfsph_stats();
   const auto hits_settling = settled.max_iteration_hits;
@@ -110,14 +107,14 @@ ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool 
   r.dt = sim.last_dt();
   const auto& st = sim.dfsph_stats();
   std::cout << "[dfsph hydrostatic] " << (cg ? "cg" : "jacobi") << " walls "
-            << (hydrostatic ? "hydrostatic"
-                : mirror    ? "mirrored"
-                            : "zero")
-            << " steps " << sim.steps() << " dt " << r.dt << " p(lower half)/rho g d " << r.p_mid
-            << " p(bottom row)/rho g d " << r.p_bot << " density sweeps/step "
-            << double(st.density_iterations) / double(st.steps) << " divergence sweeps/step "
-            << double(st.divergence_iterations) / double(st.steps) << " max density error " << r.max_error
-            << "% kinetic " << r.kinetic << " J\n";
+            << (c.walls == DfsphWallPressure::Hydrostatic ? "hydrostatic"
+                : c.walls == DfsphWallPressure::Mirrored  ? "mirrored"
+                                                          : "zero")
+            << " support " << c.support << " s, mu " << c.mu << " Pa s, steps " << sim.steps() << " dt "
+            << r.dt << " p(lower half)/rho g d " << r.p_mid << " p(bottom row)/rho g d " << r.p_bot
+            << " density sweeps/step " << double(st.density_iterations) / double(st.steps)
+            << " divergence sweeps/step " << double(st.divergence_iterations) / double(st.steps)
+            << " max density error " << r.max_error << "% kinetic " << r.kinetic << " J\n";
   return r;
 }
 
@@ -125,7 +122,7 @@ ColumnRun settle_column(bool mirror, double dt_max, bool check_every_step, bool 
 // within 5%. The bottom row carries the column on the wall's k = 0 terms alone (Akinci's unmirrored
 // pressure, as SPlisHSPlasH): its pressure is 1.5-2x rho0 g d (measured 1.77), checked as such.
 TEST(Dfsph, HydrostaticColumnFollowsRhoGDepth) {
-  const ColumnRun r = settle_column(false, 0.005, true);
+  const ColumnRun r = settle_column(column(DfsphWallPressure::Zero, 0.005), true);
   EXPECT_EQ(r.dt, 0.005) << "the column should be slow enough for dt_max";
   EXPECT_EQ(r.hits, 0u) << "a solve stopped at max_iterations";
   EXPECT_NEAR(r.p_mid, 1.0, 0.05);
@@ -138,7 +135,7 @@ TEST(Dfsph, HydrostaticColumnFollowsRhoGDepth) {
 // 10% of rho0 g d (measured 1.06: the wall's pressure is the particle's own, a zeroth-order extrapolation
 // of a field that grows downwards).
 TEST(Dfsph, MirroredWallsCarryTheBottomRowAtRhoGDepth) {
-  const ColumnRun r = settle_column(true, 0.005, true);
+  const ColumnRun r = settle_column(column(DfsphWallPressure::Mirrored, 0.005), true);
   EXPECT_EQ(r.dt, 0.005);
   EXPECT_EQ(r.hits, 0u) << "a solve stopped at max_iterations";
   EXPECT_NEAR(r.p_mid, 1.0, 0.05);
@@ -151,17 +148,38 @@ TEST(Dfsph, MirroredWallsCarryTheBottomRowAtRhoGDepth) {
 // 1.014 and 1.010 at 5 ms; 0.995 and 1.005 at 8 ms, where it settles too). At 8.7 ms (20.3x) it still
 // sloshes (0.80x after 2 s, 19 solves at max_iterations; docs/physics.md).
 TEST(Dfsph, HydrostaticWallsCarryTheBottomRowAtRhoGDepth) {
-  const ColumnRun r = settle_column(true, 0.005, true, true);
+  const ColumnRun r = settle_column(column(DfsphWallPressure::Hydrostatic, 0.005), true);
   EXPECT_EQ(r.dt, 0.005);
   EXPECT_EQ(r.hits, 0u) << "a solve stopped at max_iterations";
   EXPECT_NEAR(r.p_mid, 1.0, 0.02);
   EXPECT_NEAR(r.p_bot, 1.0, 0.02);
   EXPECT_LT(r.kinetic, r.kinetic_bound) << "not settled";
-  const ColumnRun longer = settle_column(true, 0.008, false, true);
+  const ColumnRun longer = settle_column(column(DfsphWallPressure::Hydrostatic, 0.008), false);
   EXPECT_EQ(longer.dt, 0.008);
   EXPECT_LT(longer.kinetic, longer.kinetic_bound) << "not settled at 8 ms";
   EXPECT_NEAR(longer.p_mid, 1.0, 0.02);
   EXPECT_NEAR(longer.p_bot, 1.0, 0.02);
+}
+
+// The 20x the WCSPH step. A resting column's longest step scales as d / sqrt(g H), as the WCSPH
+// step does, so their ratio is set by the support: 17-19x at h = 2 s and 24-25x at h = 2.5 s, at depths
+// 0.4-0.8 m and spacings 0.01-0.04 m (docs/physics.md, tools/dfsph_column.cpp). With h = 2.5 s and
+// hydrostatic walls, steps of 20.5x the WCSPH step of the same resolution and support (11 against
+// 0.535 ms) keep every step at the 0.05% bound with no solve at max_iterations, and both pressures within
+// 2% of rho0 g d (measured 0.996 and 0.992). The same column at h = 2 s leaves its tank at these steps.
+// mu = 2 Pa s: at the other tests' 5 Pa s the explicit viscosity's own limit (0.125 d^2 / nu, 10 ms) would
+// hold the step below 20x.
+TEST(Dfsph, WiderSupportHoldsTheColumnAtTwentyTimesTheWcsphStep) {
+  test::DfsphColumn c = column(DfsphWallPressure::Hydrostatic, 0.011);
+  c.support = 2.5;
+  c.mu = 2;
+  ASSERT_GE(c.dt_max / c.wcsph_step(), 20.0);
+  const ColumnRun r = settle_column(c, true);
+  EXPECT_EQ(r.dt, c.dt_max) << "the column should be slow enough for dt_max";
+  EXPECT_EQ(r.hits, 0u) << "a solve stopped at max_iterations";
+  EXPECT_NEAR(r.p_mid, 1.0, 0.02);
+  EXPECT_NEAR(r.p_bot, 1.0, 0.02);
+  EXPECT_LT(r.kinetic, r.kinetic_bound) << "not settled";
 }
 
 // Hydrostatic walls in a tank that moves: the column of HydrostaticColumnFollowsRhoGDepth (mu 5 Pa s, 5 ms
@@ -223,7 +241,7 @@ TEST(Dfsph, HydrostaticWallsFollowTheTanksAcceleration) {
 // (walls at k = 0 measured 1.8 J of motion against the 0.63 J bound there, their bottom row sliding on
 // the floor). Some solves reach max_iterations at this step, so the per-step bound is not checked.
 TEST(Dfsph, MirroredWallsSettleTheColumnAtLongerSteps) {
-  const ColumnRun r = settle_column(true, 0.008, false);
+  const ColumnRun r = settle_column(column(DfsphWallPressure::Mirrored, 0.008), false);
   EXPECT_EQ(r.dt, 0.008);
   EXPECT_LT(r.kinetic, r.kinetic_bound) << "not settled";
   EXPECT_NEAR(r.p_mid, 1.0, 0.05);
@@ -416,8 +434,8 @@ TEST(Dfsph, SmallColumn2DFloat) {
 // the last step's pressure, it meets the bound in less than half the iterations, stops at max_iterations
 // no more often, and gives rho0 g d in the lower half and the bottom row.
 TEST(Dfsph, CgDensitySolveTakesTheDeepColumnInFewerIterations) {
-  const ColumnRun jacobi = settle_column(true, 0.008, false, true);
-  const ColumnRun cg = settle_column(true, 0.008, false, true, true, 0.85);
+  const ColumnRun jacobi = settle_column(column(DfsphWallPressure::Hydrostatic, 0.008), false);
+  const ColumnRun cg = settle_column(column(DfsphWallPressure::Hydrostatic, 0.008), false, true, 0.85);
   EXPECT_LT(cg.sweeps, 0.5 * jacobi.sweeps);
   EXPECT_LE(cg.hits, jacobi.hits);
   EXPECT_NEAR(cg.p_mid, 1.0, 0.05);

@@ -48,6 +48,35 @@ SolverConfig<Dim, Real> dfsph_water(Real s, Real mu, Real dt_max) {
   return cfg;
 }
 
+// The resting column of the DFSPH step-limit checks (solver/dfsph_test.cpp, tools/dfsph_column.cpp): water
+// `width` x `depth` at spacing s in an open tank of two layers of wall particles weighted like the fluid
+// (rho0 s^2, so the lattice starts at rest density), dfsph_water with viscosity mu, steps of at most dt_max,
+// support h = `support` s (2 unless a case says otherwise), walls whose pressure is `walls`.
+struct DfsphColumn {
+  double s = 0.02, width = 0.4, depth = 0.4, support = 2, mu = 5, dt_max = 0.005;
+  DfsphWallPressure walls = DfsphWallPressure::Hydrostatic;
+  static constexpr double rho0 = 1000, g = 9.81;
+  // The WCSPH Courant step of the same resolution and support, 0.3 h / c with c = 10 sqrt(2 g depth) (the
+  // dam-break scenes' sound speed and Courant number): what the "20x the WCSPH step" measures by.
+  [[nodiscard]] double wcsph_step() const { return 0.3 * support * s / (10 * std::sqrt(2 * g * depth)); }
+  [[nodiscard]] SolverConfig<2, double> config() const {
+    auto cfg = dfsph_water<2, double>(s, mu, dt_max);
+    cfg.support = support * s;
+    cfg.dfsph.wall_pressure = walls;
+    cfg.domain_set = true;
+    cfg.domain_lo = Vec<2, double>{{-0.1, -0.1}};
+    cfg.domain_hi = Vec<2, double>{{width + 0.1, 2 * depth}};
+    return cfg;
+  }
+  [[nodiscard]] Particles<2, double> particles() const {
+    Particles<2, double> p;
+    add_block<2, double>(p, Vec<2, double>{{0, 0}}, Vec<2, double>{{width, depth}}, s, 0);
+    add_box_walls<2, double>(p, Vec<2, double>{{0, 0}}, Vec<2, double>{{width, depth + 2 * s}}, s, 2, true, 0,
+                             rho0 * s * s);
+    return p;
+  }
+};
+
 // 2D WCSPH water as the dam-break scenes set it up: cubic kernels, h = 2 spacings, ratio EOS with sound
 // speed c, clamped negative pressure, the artificial viscosity mu = rho0 alpha h c / (2 (d + 2)) with
 // alpha = 0.02, Courant steps.
