@@ -2,14 +2,15 @@
 // step-limit tests (test::DfsphColumn, solver/dfsph_test.cpp) at any depth, step, support, spacing and wall
 // pressure, to find the longest step at which it settles (docs/physics.md, "Model 3", "The step limit of a
 // resting column"):
-//   build/release/cellsph_dfsph_column DEPTH DT_MAX [--support 2] [--mu 5] [--spacing 0.02] [--width 0.4]
-//       [--walls hydrostatic|mirrored|zero] [--solver jacobi|cg] [--max-iterations 100] [--until 3]
+//   build/release/cellsph_dfsph_column DEPTH DT_MAX [--dim 2|3] [--support 2] [--mu 5] [--spacing 0.02]
+//       [--width 0.4] [--walls hydrostatic|mirrored|zero] [--solver jacobi|cg] [--max-iterations 100]
+//       [--until 3]
 // Every half second: kinetic energy (against the tests' bound, 1e-3 M g H), the step, density and divergence
 // sweeps a step, solves stopped at max_iterations, the last density error. Last line, over the final second
 // (t > until - 1, as the tests sample): the pressure against rho0 g d over the lower half above the bottom
 // row and over the bottom row; after the first second (all of a run shorter than 2 s): solves at
-// max_iterations and the largest density error. A run
-// that leaves its domain prints the simulation's diagnosis. One thread.
+// max_iterations and the largest density error. A run that leaves its domain prints the simulation's
+// diagnosis. One thread.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -28,8 +29,9 @@ namespace {
 int usage() {
   std::fprintf(
       stderr,
-      "usage: cellsph_dfsph_column DEPTH DT_MAX [--support S] [--mu PA_S] [--spacing M] [--width M]\n"
-      "       [--walls hydrostatic|mirrored|zero] [--solver jacobi|cg] [--max-iterations N] [--until T]\n");
+      "usage: cellsph_dfsph_column DEPTH DT_MAX [--dim 2|3] [--support S] [--mu PA_S] [--spacing M]\n"
+      "       [--width M] [--walls hydrostatic|mirrored|zero] [--solver jacobi|cg] [--max-iterations N]\n"
+      "       [--until T]\n");
   return 2;
 }
 
@@ -42,10 +44,11 @@ double number(const char* text) {
 
 struct Sample {
   double p_mid = 0, ref_mid = 0, p_bot = 0, ref_bot = 0;
-  void add(const test::DfsphColumn& c, const Particles<2, double>& q) {
+  template <int Dim>
+  void add(const test::DfsphColumn<Dim>& c, const Particles<Dim, double>& q) {
     for (std::size_t i = 0; i < q.size(); ++i) {
       if (q.kind[i] != 0) continue;
-      const double y = q.x[i][1], ref = c.rho0 * c.g * (c.depth - y);
+      const double y = q.x[i][Dim - 1], ref = c.rho0 * c.g * (c.depth - y);
       if (y < c.s) {
         p_bot += q.p[i];
         ref_bot += ref;
@@ -57,7 +60,8 @@ struct Sample {
   }
 };
 
-void report(const Simulation<2, double>& sim, const DfsphStats& prev, double bound) {
+template <int Dim>
+void report(const Simulation<Dim, double>& sim, const DfsphStats& prev, double bound) {
   const auto& st = sim.dfsph_stats();
   const double steps = double(std::max<std::uint64_t>(st.steps - prev.steps, 1));
   std::printf(
@@ -70,77 +74,46 @@ void report(const Simulation<2, double>& sim, const DfsphStats& prev, double bou
       st.last_density_error);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  if (argc < 3) return usage();
-  test::DfsphColumn c;
-  c.depth = number(argv[1]);
-  c.dt_max = number(argv[2]);
+// What the command line chose beyond the column itself.
+struct Options {
   bool cg = false;
   int max_iterations = 100;
   double until = 3;
-  for (int k = 3; k < argc; k += 2) {
-    if (k + 1 >= argc) return usage();
-    const std::string key = argv[k];
-    const char* value = argv[k + 1];
-    if (key == "--support")
-      c.support = number(value);
-    else if (key == "--mu")
-      c.mu = number(value);
-    else if (key == "--spacing")
-      c.s = number(value);
-    else if (key == "--width")
-      c.width = number(value);
-    else if (key == "--until")
-      until = number(value);
-    else if (key == "--max-iterations")
-      max_iterations = std::atoi(value);
-    else if (key == "--solver" && (std::string(value) == "jacobi" || std::string(value) == "cg"))
-      cg = std::string(value) == "cg";
-    else if (key == "--walls" && std::string(value) == "hydrostatic")
-      c.walls = DfsphWallPressure::Hydrostatic;
-    else if (key == "--walls" && std::string(value) == "mirrored")
-      c.walls = DfsphWallPressure::Mirrored;
-    else if (key == "--walls" && std::string(value) == "zero")
-      c.walls = DfsphWallPressure::Zero;
-    else
-      return usage();
-  }
-  if (c.depth <= 0 || c.dt_max <= 0 || c.support <= 0 || c.mu <= 0 || c.s <= 0 || c.width <= 0 ||
-      until <= 0 || max_iterations < 1)
-    return usage();
+};
+
+template <int Dim>
+int run(const test::DfsphColumn<Dim>& c, const Options& o) {
   auto cfg = c.config();
-  cfg.dfsph.max_iterations = max_iterations;
-  if (cg) {
+  cfg.dfsph.max_iterations = o.max_iterations;
+  if (o.cg) {
     cfg.dfsph.density_solver = DfsphDensitySolver::ConjugateGradient;
     cfg.dfsph.warm_start_scale = 0.85;
   }
   ScopedThreads one(1);
   std::printf(
-      "column %g x %g m, spacing %g m, support %g s, mu %g Pa s, %s walls, %s; dt_max %g ms = %.2fx the "
-      "WCSPH step of this resolution and support (%.4f ms)\n",
-      c.width, c.depth, c.s, c.support, c.mu,
+      "%dD column %g wide, %g m deep, spacing %g m, support %g s, mu %g Pa s, %s walls, %s; dt_max %g ms = "
+      "%.2fx the WCSPH step of this resolution and support (%.4f ms)\n",
+      Dim, c.width, c.depth, c.s, c.support, c.mu,
       c.walls == DfsphWallPressure::Hydrostatic ? "hydrostatic"
       : c.walls == DfsphWallPressure::Mirrored  ? "mirrored"
                                                 : "zero",
-      cg ? "CG" : "Jacobi", c.dt_max * 1e3, c.dt_max / c.wcsph_step(), c.wcsph_step() * 1e3);
+      o.cg ? "CG" : "Jacobi", c.dt_max * 1e3, c.dt_max / c.wcsph_step(), c.wcsph_step() * 1e3);
   try {
-    Simulation<2, double> sim(cfg, c.particles());
+    Simulation<Dim, double> sim(cfg, c.particles());
     const double bound = 1e-3 * sim.total_mass() * c.g * c.depth;
     DfsphStats prev = sim.dfsph_stats(), settled{};
-    const double settle = until >= 2 ? 1.0 : 0.0;  // the tests settle for 1 s
+    const double settle = o.until >= 2 ? 1.0 : 0.0;  // the tests settle for 1 s
     bool past_one = settle == 0;
     double max_error = 0, next = 0.5;
     Sample sample;
-    while (sim.time() < until - 1e-12) {
+    while (sim.time() < o.until - 1e-12) {
       sim.step();
       if (!past_one && sim.time() > settle) {
         past_one = true;
         settled = sim.dfsph_stats();
       }
       if (past_one) max_error = std::max(max_error, sim.dfsph_stats().last_density_error);
-      if (sim.time() > until - 1) sample.add(c, sim.particles());
+      if (sim.time() > o.until - 1) sample.add(c, sim.particles());
       if (sim.time() >= next - 1e-12) {
         report(sim, prev, bound);
         prev = sim.dfsph_stats();
@@ -159,4 +132,56 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) return usage();
+  test::DfsphColumn<2> c;  // the column's numbers; run<3> copies them
+  c.depth = number(argv[1]);
+  c.dt_max = number(argv[2]);
+  Options o;
+  int dim = 2;
+  for (int k = 3; k < argc; k += 2) {
+    if (k + 1 >= argc) return usage();
+    const std::string key = argv[k], value = argv[k + 1];
+    if (key == "--dim" && (value == "2" || value == "3"))
+      dim = value == "2" ? 2 : 3;
+    else if (key == "--support")
+      c.support = number(value.c_str());
+    else if (key == "--mu")
+      c.mu = number(value.c_str());
+    else if (key == "--spacing")
+      c.s = number(value.c_str());
+    else if (key == "--width")
+      c.width = number(value.c_str());
+    else if (key == "--until")
+      o.until = number(value.c_str());
+    else if (key == "--max-iterations")
+      o.max_iterations = std::atoi(value.c_str());
+    else if (key == "--solver" && (value == "jacobi" || value == "cg"))
+      o.cg = value == "cg";
+    else if (key == "--walls" && value == "hydrostatic")
+      c.walls = DfsphWallPressure::Hydrostatic;
+    else if (key == "--walls" && value == "mirrored")
+      c.walls = DfsphWallPressure::Mirrored;
+    else if (key == "--walls" && value == "zero")
+      c.walls = DfsphWallPressure::Zero;
+    else
+      return usage();
+  }
+  if (c.depth <= 0 || c.dt_max <= 0 || c.support <= 0 || c.mu <= 0 || c.s <= 0 || c.width <= 0 ||
+      o.until <= 0 || o.max_iterations < 1)
+    return usage();
+  if (dim == 2) return run(c, o);
+  test::DfsphColumn<3> c3;
+  c3.s = c.s;
+  c3.width = c.width;
+  c3.depth = c.depth;
+  c3.support = c.support;
+  c3.mu = c.mu;
+  c3.dt_max = c.dt_max;
+  c3.walls = c.walls;
+  return run(c3, o);
 }

@@ -56,15 +56,15 @@ struct ColumnRun {
   double sweeps = 0;  // density iterations a step after settling
 };
 
-test::DfsphColumn column(DfsphWallPressure walls, double dt_max) {
-  test::DfsphColumn c;
+test::DfsphColumn<2> column(DfsphWallPressure walls, double dt_max) {
+  test::DfsphColumn<2> c;
   c.walls = walls;
   c.dt_max = dt_max;
   return c;
 }
 
 // `cg`: the conjugate-gradient density solve (models/dfsph_cg.hpp) from warm_scale of the last k.
-ColumnRun settle_column(const test::DfsphColumn& c, bool check_every_step, bool cg = false,
+ColumnRun settle_column(const test::DfsphColumn<2>& c, bool check_every_step, bool cg = false,
                         double warm_scale = 0.5) {
   const double s = c.s, H = c.depth, rho0 = c.rho0, g = c.g;
   auto cfg = c.config();

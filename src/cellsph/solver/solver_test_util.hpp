@@ -49,31 +49,42 @@ SolverConfig<Dim, Real> dfsph_water(Real s, Real mu, Real dt_max) {
 }
 
 // The resting column of the DFSPH step-limit checks (solver/dfsph_test.cpp, tools/dfsph_column.cpp): water
-// `width` x `depth` at spacing s in an open tank of two layers of wall particles weighted like the fluid
-// (rho0 s^2, so the lattice starts at rest density), dfsph_water with viscosity mu, steps of at most dt_max,
-// support h = `support` s (2 unless a case says otherwise), walls whose pressure is `walls`.
+// `width` wide (in every horizontal direction) and `depth` deep at spacing s in an open tank of two layers
+// of wall particles weighted like the fluid (rho0 s^Dim, so the lattice starts at rest density),
+// dfsph_water with viscosity mu, steps of at most dt_max, support h = `support` s (2 unless a case says
+// otherwise), walls whose pressure is `walls`. Gravity is along the last axis.
+template <int Dim = 2>
 struct DfsphColumn {
+  using V = Vec<Dim, double>;
   double s = 0.02, width = 0.4, depth = 0.4, support = 2, mu = 5, dt_max = 0.005;
   DfsphWallPressure walls = DfsphWallPressure::Hydrostatic;
   static constexpr double rho0 = 1000, g = 9.81;
   // The WCSPH Courant step of the same resolution and support, 0.3 h / c with c = 10 sqrt(2 g depth) (the
   // dam-break scenes' sound speed and Courant number): what the "20x the WCSPH step" measures by.
   [[nodiscard]] double wcsph_step() const { return 0.3 * support * s / (10 * std::sqrt(2 * g * depth)); }
-  [[nodiscard]] SolverConfig<2, double> config() const {
-    auto cfg = dfsph_water<2, double>(s, mu, dt_max);
+  [[nodiscard]] SolverConfig<Dim, double> config() const {
+    auto cfg = dfsph_water<Dim, double>(s, mu, dt_max);
     cfg.support = support * s;
     cfg.dfsph.wall_pressure = walls;
     cfg.domain_set = true;
-    cfg.domain_lo = Vec<2, double>{{-0.1, -0.1}};
-    cfg.domain_hi = Vec<2, double>{{width + 0.1, 2 * depth}};
+    cfg.domain_lo = corner(-0.1, -0.1);
+    cfg.domain_hi = corner(width + 0.1, 2 * depth);
     return cfg;
   }
-  [[nodiscard]] Particles<2, double> particles() const {
-    Particles<2, double> p;
-    add_block<2, double>(p, Vec<2, double>{{0, 0}}, Vec<2, double>{{width, depth}}, s, 0);
-    add_box_walls<2, double>(p, Vec<2, double>{{0, 0}}, Vec<2, double>{{width, depth + 2 * s}}, s, 2, true, 0,
-                             rho0 * s * s);
+  [[nodiscard]] Particles<Dim, double> particles() const {
+    Particles<Dim, double> p;
+    add_block<Dim, double>(p, corner(0, 0), corner(width, depth), s, 0);
+    double weight = rho0;
+    for (int a = 0; a < Dim; ++a) weight *= s;
+    add_box_walls<Dim, double>(p, corner(0, 0), corner(width, depth + 2 * s), s, 2, true, 0, weight);
     return p;
+  }
+  // The point at `horizontal` along every axis but the last, `vertical` along the last.
+  static V corner(double horizontal, double vertical) {
+    V c{};
+    for (int a = 0; a + 1 < Dim; ++a) c[a] = horizontal;
+    c[Dim - 1] = vertical;
+    return c;
   }
 };
 
