@@ -42,24 +42,6 @@ double number(const char* text) {
   return end != text && *end == '\0' && v > 0 && v < 1e30 ? v : -1;
 }
 
-struct Sample {
-  double p_mid = 0, ref_mid = 0, p_bot = 0, ref_bot = 0;
-  template <int Dim>
-  void add(const test::DfsphColumn<Dim>& c, const Particles<Dim, double>& q) {
-    for (std::size_t i = 0; i < q.size(); ++i) {
-      if (q.kind[i] != 0) continue;
-      const double y = q.x[i][Dim - 1], ref = c.rho0 * c.g * (c.depth - y);
-      if (y < c.s) {
-        p_bot += q.p[i];
-        ref_bot += ref;
-      } else if (y < c.depth / 2) {
-        p_mid += q.p[i];
-        ref_mid += ref;
-      }
-    }
-  }
-};
-
 template <int Dim>
 void report(const Simulation<Dim, double>& sim, const DfsphStats& prev, double bound) {
   const auto& st = sim.dfsph_stats();
@@ -93,10 +75,7 @@ int run(const test::DfsphColumn<Dim>& c, const Options& o) {
   std::printf(
       "%dD column %g wide, %g m deep, spacing %g m, support %g s, mu %g Pa s, %s walls, %s; dt_max %g ms = "
       "%.2fx the WCSPH step of this resolution and support (%.4f ms)\n",
-      Dim, c.width, c.depth, c.s, c.support, c.mu,
-      c.walls == DfsphWallPressure::Hydrostatic ? "hydrostatic"
-      : c.walls == DfsphWallPressure::Mirrored  ? "mirrored"
-                                                : "zero",
+      Dim, c.width, c.depth, c.s, c.support, c.mu, test::dfsph_wall_pressure_name(c.walls),
       o.cg ? "CG" : "Jacobi", c.dt_max * 1e3, c.dt_max / c.wcsph_step(), c.wcsph_step() * 1e3);
   try {
     Simulation<Dim, double> sim(cfg, c.particles());
@@ -105,7 +84,7 @@ int run(const test::DfsphColumn<Dim>& c, const Options& o) {
     const double settle = o.until >= 2 ? 1.0 : 0.0;  // the tests settle for 1 s
     bool past_one = settle == 0;
     double max_error = 0, next = 0.5;
-    Sample sample;
+    typename test::DfsphColumn<Dim>::PressureSums sums;
     while (sim.time() < o.until - 1e-12) {
       sim.step();
       if (!past_one && sim.time() > settle) {
@@ -113,7 +92,7 @@ int run(const test::DfsphColumn<Dim>& c, const Options& o) {
         settled = sim.dfsph_stats();
       }
       if (past_one) max_error = std::max(max_error, sim.dfsph_stats().last_density_error);
-      if (sim.time() > o.until - 1) sample.add(c, sim.particles());
+      if (sim.time() > o.until - 1) c.add_pressures(sim.particles(), sums);
       if (sim.time() >= next - 1e-12) {
         report(sim, prev, bound);
         prev = sim.dfsph_stats();
@@ -124,7 +103,7 @@ int run(const test::DfsphColumn<Dim>& c, const Options& o) {
         "result: ratio %.2f  kinetic %.3e J (%s)  p / rho0 g d: lower half %.4f, bottom row %.4f  "
         "after %g s: max_iterations stops %llu, largest density error %.4f%%\n",
         c.dt_max / c.wcsph_step(), sim.kinetic_energy(), sim.kinetic_energy() < bound ? "settled" : "moving",
-        sample.p_mid / sample.ref_mid, sample.p_bot / sample.ref_bot, settle,
+        sums.mid(), sums.bottom(), settle,
         static_cast<unsigned long long>(sim.dfsph_stats().max_iteration_hits - settled.max_iteration_hits),
         max_error);
   } catch (const std::exception& e) {
@@ -134,20 +113,18 @@ int run(const test::DfsphColumn<Dim>& c, const Options& o) {
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  if (argc < 3) return usage();
-  test::DfsphColumn<2> c;  // the column's numbers; run<3> copies them
+// Reads the options after DEPTH and DT_MAX into a column of dimension Dim (--dim chose it) and runs it.
+template <int Dim>
+int parse_and_run(int argc, char** argv) {
+  test::DfsphColumn<Dim> c;
   c.depth = number(argv[1]);
   c.dt_max = number(argv[2]);
   Options o;
-  int dim = 2;
   for (int k = 3; k < argc; k += 2) {
     if (k + 1 >= argc) return usage();
     const std::string key = argv[k], value = argv[k + 1];
     if (key == "--dim" && (value == "2" || value == "3"))
-      dim = value == "2" ? 2 : 3;
+      continue;  // main read it
     else if (key == "--support")
       c.support = number(value.c_str());
     else if (key == "--mu")
@@ -174,14 +151,15 @@ int main(int argc, char** argv) {
   if (c.depth <= 0 || c.dt_max <= 0 || c.support <= 0 || c.mu <= 0 || c.s <= 0 || c.width <= 0 ||
       o.until <= 0 || o.max_iterations < 1)
     return usage();
-  if (dim == 2) return run(c, o);
-  test::DfsphColumn<3> c3;
-  c3.s = c.s;
-  c3.width = c.width;
-  c3.depth = c.depth;
-  c3.support = c.support;
-  c3.mu = c.mu;
-  c3.dt_max = c.dt_max;
-  c3.walls = c.walls;
-  return run(c3, o);
+  return run(c, o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) return usage();
+  for (int k = 3; k + 1 < argc; k += 2)
+    if (std::string(argv[k]) == "--dim" && std::string(argv[k + 1]) == "3")
+      return parse_and_run<3>(argc, argv);
+  return parse_and_run<2>(argc, argv);
 }

@@ -66,7 +66,6 @@ test::DfsphColumn<2> column(DfsphWallPressure walls, double dt_max) {
 // `cg`: the conjugate-gradient density solve (models/dfsph_cg.hpp) from warm_scale of the last k.
 ColumnRun settle_column(const test::DfsphColumn<2>& c, bool check_every_step, bool cg = false,
                         double warm_scale = 0.5) {
-  const double s = c.s, H = c.depth, rho0 = c.rho0, g = c.g;
   auto cfg = c.config();
   if (cg) cfg.dfsph.density_solver = DfsphDensitySolver::ConjugateGradient;
   cfg.dfsph.warm_start_scale = warm_scale;
@@ -75,7 +74,7 @@ ColumnRun settle_column(const test::DfsphColumn<2>& c, bool check_every_step, bo
   sim.run_until(1.0);
   const auto settled = sim.dfsph_stats();
   const auto hits_settling = settled.max_iteration_hits;
-  double p_mid = 0, ref_mid = 0, p_bot = 0, ref_bot = 0;
+  test::DfsphColumn<2>::PressureSums sums;
   ColumnRun r;
   while (sim.time() < 2.0) {
     sim.step();
@@ -84,37 +83,24 @@ ColumnRun settle_column(const test::DfsphColumn<2>& c, bool check_every_step, bo
       EXPECT_LE(sim.dfsph_stats().last_density_error, 0.05);
     }
     r.max_error = std::max(r.max_error, sim.dfsph_stats().last_density_error);
-    const auto& q = sim.particles();
-    for (std::size_t i = 0; i < q.size(); ++i) {
-      if (q.kind[i] != 0) continue;
-      const double y = q.x[i][1], depth = H - y;
-      if (y < s) {
-        p_bot += q.p[i];
-        ref_bot += rho0 * g * depth;
-      } else if (y < H / 2) {
-        p_mid += q.p[i];
-        ref_mid += rho0 * g * depth;
-      }
-    }
+    c.add_pressures(sim.particles(), sums);
   }
-  r.p_mid = p_mid / ref_mid;
-  r.p_bot = p_bot / ref_bot;
+  r.p_mid = sums.mid();
+  r.p_bot = sums.bottom();
   r.hits = sim.dfsph_stats().max_iteration_hits - hits_settling;
   r.sweeps = double(sim.dfsph_stats().density_iterations - settled.density_iterations) /
              double(sim.dfsph_stats().steps - settled.steps);
   r.kinetic = sim.kinetic_energy();
-  r.kinetic_bound = 1e-3 * sim.total_mass() * g * H;
+  r.kinetic_bound = 1e-3 * sim.total_mass() * c.g * c.depth;
   r.dt = sim.last_dt();
   const auto& st = sim.dfsph_stats();
   std::cout << "[dfsph hydrostatic] " << (cg ? "cg" : "jacobi") << " walls "
-            << (c.walls == DfsphWallPressure::Hydrostatic ? "hydrostatic"
-                : c.walls == DfsphWallPressure::Mirrored  ? "mirrored"
-                                                          : "zero")
-            << " support " << c.support << " s, mu " << c.mu << " Pa s, steps " << sim.steps() << " dt "
-            << r.dt << " p(lower half)/rho g d " << r.p_mid << " p(bottom row)/rho g d " << r.p_bot
-            << " density sweeps/step " << double(st.density_iterations) / double(st.steps)
-            << " divergence sweeps/step " << double(st.divergence_iterations) / double(st.steps)
-            << " max density error " << r.max_error << "% kinetic " << r.kinetic << " J\n";
+            << test::dfsph_wall_pressure_name(c.walls) << " support " << c.support << " s, mu " << c.mu
+            << " Pa s, steps " << sim.steps() << " dt " << r.dt << " p(lower half)/rho g d " << r.p_mid
+            << " p(bottom row)/rho g d " << r.p_bot << " density sweeps/step "
+            << double(st.density_iterations) / double(st.steps) << " divergence sweeps/step "
+            << double(st.divergence_iterations) / double(st.steps) << " max density error " << r.max_error
+            << "% kinetic " << r.kinetic << " J\n";
   return r;
 }
 

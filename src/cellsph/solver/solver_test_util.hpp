@@ -48,6 +48,12 @@ SolverConfig<Dim, Real> dfsph_water(Real s, Real mu, Real dt_max) {
   return cfg;
 }
 
+inline const char* dfsph_wall_pressure_name(DfsphWallPressure w) {
+  return w == DfsphWallPressure::Hydrostatic ? "hydrostatic"
+         : w == DfsphWallPressure::Mirrored  ? "mirrored"
+                                             : "zero";
+}
+
 // The resting column of the DFSPH step-limit checks (solver/dfsph_test.cpp, tools/dfsph_column.cpp): water
 // `width` wide (in every horizontal direction) and `depth` deep at spacing s in an open tank of two layers
 // of wall particles weighted like the fluid (rho0 s^Dim, so the lattice starts at rest density),
@@ -78,6 +84,25 @@ struct DfsphColumn {
     for (int a = 0; a < Dim; ++a) weight *= s;
     add_box_walls<Dim, double>(p, corner(0, 0), corner(width, depth + 2 * s), s, 2, true, 0, weight);
     return p;
+  }
+  // The solver's pressure against rho0 g d, summed over the bottom row and over the lower half above it.
+  struct PressureSums {
+    double p_mid = 0, ref_mid = 0, p_bot = 0, ref_bot = 0;
+    [[nodiscard]] double mid() const { return p_mid / ref_mid; }
+    [[nodiscard]] double bottom() const { return p_bot / ref_bot; }
+  };
+  void add_pressures(const Particles<Dim, double>& q, PressureSums& sums) const {
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      if (q.kind[i] != 0) continue;
+      const double y = q.x[i][Dim - 1], ref = rho0 * g * (depth - y);
+      if (y < s) {
+        sums.p_bot += q.p[i];
+        sums.ref_bot += ref;
+      } else if (y < depth / 2) {
+        sums.p_mid += q.p[i];
+        sums.ref_mid += ref;
+      }
+    }
   }
   // The point at `horizontal` along every axis but the last, `vertical` along the last.
   static V corner(double horizontal, double vertical) {
