@@ -16,9 +16,11 @@ if(NOT nlohmann_json_FOUND)
 endif()
 include(cmake/builtin_scenes.cmake)
 
-file(GLOB CELLSPH_GPU_SOURCES CONFIGURE_DEPENDS src/cellsph/core/*.cpp src/cellsph/neighbors/*.cpp
-  src/cellsph/physics/*.cpp src/cellsph/solver/*.cpp src/cellsph/solver/device/*.cpp src/cellsph/probes/*.cpp
-  src/cellsph/scene/*.cpp src/cellsph/geometry/*.cpp src/cellsph/cuda/*.cu)
+# Whole folders, subfolders included (solver/boundary/ holds the moving walls and the rigid bodies), so
+# that a source added to one of them needs no edit here.
+file(GLOB_RECURSE CELLSPH_GPU_SOURCES CONFIGURE_DEPENDS src/cellsph/core/*.cpp src/cellsph/neighbors/*.cpp
+  src/cellsph/physics/*.cpp src/cellsph/solver/*.cpp src/cellsph/probes/*.cpp src/cellsph/scene/*.cpp
+  src/cellsph/geometry/*.cpp src/cellsph/cuda/*.cu)
 list(FILTER CELLSPH_GPU_SOURCES EXCLUDE REGEX "_(test|bench)\\.cpp$")
 add_executable(cellsph_gpu_check tools/gpu_check.cpp ${CELLSPH_GPU_SOURCES} ${CELLSPH_SCENES_CPP})
 target_include_directories(cellsph_gpu_check PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)

@@ -11,7 +11,8 @@
 #
 # Here (a machine with the Debian packages), first: scripts/gpu_check.sh --pack
 #   copies the header-only libraries (nlohmann-json, nanoflann) into gpu_headers/ (ignored by git), which
-#   must travel with the tree (the device tool's `carry`).
+#   must travel with the tree (the device tool's `carry`), and build/gpu/cellsph_gpu_check, if it was built
+#   here with the configure line below, into gpu_bin/ (ignored; carry it too to skip the build there).
 # There: scripts/gpu_check.sh        (about 2 min of build on 16 cores, then about 3 min of runs)
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +22,9 @@ if [ "${1:-}" = "--pack" ]; then
   cp -r /usr/include/nlohmann gpu_headers/
   cp /usr/include/nanoflann.hpp gpu_headers/
   du -sh gpu_headers
+  if [ -x build/gpu/cellsph_gpu_check ]; then  # built here with the command below: it travels too
+    rm -rf gpu_bin && mkdir -p gpu_bin && cp build/gpu/cellsph_gpu_check gpu_bin/ && du -sh gpu_bin
+  fi
   exit 0
 fi
 
@@ -34,24 +38,34 @@ nvidia-smi -L || true
 nvcc --version | tail -2
 cmake --version | head -1
 
-echo "== build (cmake/gpu_check.cmake, sm_90)"
-start=$(date +%s)
-cmake -S . -B build/gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELLSPH_GPU_CHECK=ON \
-  -DCMAKE_CUDA_ARCHITECTURES=90 -DCELLSPH_HEADERS="$PWD/gpu_headers" >"$OUT/configure.txt" 2>&1 ||
-  { cat "$OUT/configure.txt"; echo "FAIL configure"; exit 1; }
-timeout 300 cmake --build build/gpu -j "$JOBS" >"$OUT/build.txt" 2>&1 ||
-  { tail -60 "$OUT/build.txt"; echo "FAIL build"; exit 1; }
-echo "built in $(( $(date +%s) - start )) s"
+# A binary built here with the same command (cmake/gpu_check.cmake links libstdc++, libgcc and cudart
+# statically) can travel in gpu_bin/ (ignored by git) and saves the build there; it is used when it
+# starts there, else the sources are built.
+BIN=build/gpu/cellsph_gpu_check
+if [ -x gpu_bin/cellsph_gpu_check ] && { gpu_bin/cellsph_gpu_check --usage >/dev/null 2>&1; [ $? -eq 2 ]; }; then
+  BIN=gpu_bin/cellsph_gpu_check
+  echo "== prebuilt $BIN (built elsewhere; it starts here)"
+else
+  echo "== build (cmake/gpu_check.cmake, sm_90)"
+  start=$(date +%s)
+  cmake -S . -B build/gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELLSPH_GPU_CHECK=ON \
+    -DCMAKE_CUDA_ARCHITECTURES=90 -DCELLSPH_HEADERS="$PWD/gpu_headers" >"$OUT/configure.txt" 2>&1 ||
+    { cat "$OUT/configure.txt"; echo "FAIL configure"; exit 1; }
+  timeout 300 cmake --build build/gpu -j "$JOBS" >"$OUT/build.txt" 2>&1 ||
+    { tail -60 "$OUT/build.txt"; echo "FAIL build"; exit 1; }
+  echo "built in $(( $(date +%s) - start )) s"
+fi
 
 echo "== compare and bench (tools/gpu_check.cpp)"
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-$(nproc)}
-timeout 300 build/gpu/cellsph_gpu_check --steps 200 --bench-steps 20 --sizes "$SIZES"
+timeout 360 "$BIN" --steps 200 --dfsph-steps 50 --bench-steps 20 --sizes "$SIZES" \
+  --dfsph-until "${GPU_CHECK_DFSPH_UNTIL:-0.5}" --dfsph-wall "${GPU_CHECK_DFSPH_WALL:-30}"
 rc=$?
 echo "gpu_check exit code $rc"
 
 if command -v compute-sanitizer >/dev/null; then
   echo "== compute-sanitizer memcheck (short run; refused on some runtimes)"
-  timeout 120 compute-sanitizer --tool memcheck --error-exitcode 9 build/gpu/cellsph_gpu_check --steps 3 \
+  timeout 90 compute-sanitizer --tool memcheck --error-exitcode 9 "$BIN" --steps 3 --dfsph-steps 1 \
     --bench-steps 1 --sizes 20000 >"$OUT/memcheck.txt" 2>&1
   echo "memcheck exit code $? (9: errors found); last lines:"
   tail -15 "$OUT/memcheck.txt"
