@@ -227,6 +227,25 @@ void guarded(const std::string& what, F&& f) {
   }
 }
 
+// The backends side by side on the built-in scenes (positions after N steps, rows on the final state).
+void compare_backends(int steps, int dfsph_steps) {
+  std::printf("\n== CPU vs CUDA ==\n");
+  // Float: every expression is the CPU's (--fmad=false, IEEE division and sqrt), so the difference
+  // comes only from library functions that round differently (pow in some equations of state);
+  // 1e-5 of the extent is ~100 float ulps of it.
+  guarded("dam-break-3d", [&] { compare_steps<3, float>("dam-break-3d", steps, 1e-5); });
+  // Double: the 1e-9.
+  for (const char* name : {"dam-break-2d", "hydrostatic-tank",  // continuity density + Fourtakas
+                           "two-phase",                         // the paper's model, leap-frog
+                           "dam-break-2d-dfsph",                // DFSPH: solves, warm starts, sums
+                           "dam-break-gate",                    // a moving wall (the gate)
+                           "channel-inflow",                    // emitter and sink: counts change
+                           "floating-box"})                     // a floating body
+    guarded(name, [&] { compare_steps<2, double>(name, steps, 1e-9); });
+  // DFSPH in 3D, float, at SPlisHSPlasH's DamBreakModel size (~3 * 10^5 particles with the walls).
+  guarded("dam-break-3d-dfsph", [&] { compare_steps<3, float>("dam-break-3d-dfsph", dfsph_steps, 1e-5); });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -234,6 +253,7 @@ int main(int argc, char** argv) {
   int steps = 200, bench_steps = 20;
   double dfsph_until = 0, dfsph_wall = 60;
   int dfsph_steps = 50;
+  bool compare = true;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--sizes" && k + 1 < argc) {
@@ -249,6 +269,8 @@ int main(int argc, char** argv) {
       bench_steps = std::atoi(argv[++k]);
     } else if (a == "--dfsph-steps" && k + 1 < argc) {
       dfsph_steps = std::atoi(argv[++k]);
+    } else if (a == "--bench-only") {
+      compare = false;
     } else if (a == "--host-device") {
       g_device = Backend::HostDevice;
     } else if (a == "--dfsph-until" && k + 1 < argc) {
@@ -258,7 +280,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: cellsph_gpu_check [--sizes N,N] [--steps N] [--bench-steps N] [--dfsph-until T] "
-                   "[--dfsph-wall S] [--host-device]\n");
+                   "[--dfsph-wall S] [--host-device] [--bench-only]\n");
       return 2;
     }
   }
@@ -266,21 +288,7 @@ int main(int argc, char** argv) {
     const CudaDeviceReport dev = cuda_device_report();
     std::printf("device: %s\nOpenMP threads: %d\n", dev.text.c_str(), omp_get_max_threads());
     if (!dev.ok && g_device == Backend::Cuda) return 2;
-    std::printf("\n== CPU vs CUDA ==\n");
-    // Float: every expression is the CPU's (--fmad=false, IEEE division and sqrt), so the difference
-    // comes only from library functions that round differently (pow in some equations of state);
-    // 1e-5 of the extent is ~100 float ulps of it.
-    guarded("dam-break-3d", [&] { compare_steps<3, float>("dam-break-3d", steps, 1e-5); });
-    // Double: the 1e-9.
-    for (const char* name : {"dam-break-2d", "hydrostatic-tank",  // continuity density + Fourtakas
-                             "two-phase",                         // the paper's model, leap-frog
-                             "dam-break-2d-dfsph",                // DFSPH: solves, warm starts, sums
-                             "dam-break-gate",                    // a moving wall (the gate)
-                             "channel-inflow",                    // emitter and sink: counts change
-                             "floating-box"})                     // a floating body
-      guarded(name, [&] { compare_steps<2, double>(name, steps, 1e-9); });
-    // DFSPH in 3D, float, at SPlisHSPlasH's DamBreakModel size (~3 * 10^5 particles with the walls).
-    guarded("dam-break-3d-dfsph", [&] { compare_steps<3, float>("dam-break-3d-dfsph", dfsph_steps, 1e-5); });
+    if (compare) compare_backends(steps, dfsph_steps);
     guarded("bench", [&] { bench(sizes, 3, bench_steps, sizes.front()); });
     if (dfsph_until > 0) guarded("bench dfsph", [&] { bench_dfsph(dfsph_until, dfsph_wall); });
   } catch (const std::exception& e) {
