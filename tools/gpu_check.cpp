@@ -1,16 +1,18 @@
 // The program of scripts/gpu_check.sh (built by cmake/gpu_check.cmake on a GPU machine): compares the CUDA
 // backend with the CPU and times it. Writes a plain-text report to stdout (the script keeps it).
 //  1. device: the CUDA device report (exit 2 without a usable device);
-//  2. rows: the device grid's neighbour rows against the CPU search (every method gives the same CSR
-//     rows), on the start and the end state of the 3D dam break: they must be equal, exactly;
-//  3. steps: dam-break-3d (float) and dam-break-2d (double), N steps on each backend; positions compared
-//     (bit-identical count, largest difference relative to the domain) against the stated tolerances;
+//  2. steps: the built-in scenes of compare_backends (WCSPH, the paper model, DFSPH in 2D and 3D, a moving
+//     wall, inflow, a floating body), N steps on each backend; positions compared (bit-identical count,
+//     largest difference relative to the domain) against the stated tolerances;
+//  3. rows: on each scene's final state, the device grid's neighbour rows against the CPU search (every
+//     method gives the same CSR rows): they must be equal, exactly;
 //  4. bench: the 3D dam break rescaled to each requested fluid count (as `cellsph bench sph`), warm-up
 //     steps, then timed steps: ms per step, the neighbour share, fluid particle-steps per second, wall
 //     time per simulated second, device memory per particle; the CPU (all cores) at the smallest size
-//     for the ratio.
-//
-// NOT RUN YET at the time of writing: no GPU was lent to the session that wrote it (docs/gpu.md).
+//     for the ratio; then (--dfsph-until) dam-break-3d-dfsph from rest on both backends.
+// --host-device runs it all on the host-emulated device (no GPU needed); --bench-only skips 2 and 3.
+// First run on an H200 on 2026-12-04: docs/gpu.md, "Measured on an H200".
+
 #include <omp.h>
 
 #include <algorithm>
