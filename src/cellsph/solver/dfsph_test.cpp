@@ -472,6 +472,25 @@ INSTANTIATE_TEST_SUITE_P(Dfsph, DfsphWalls, ::testing::Values(0, 1, 2),
                            return i.param == 0 ? "Zero" : i.param == 1 ? "Mirrored" : "Hydrostatic";
                          });
 
+// Reordering (neighbors.reorder_every) on the device permutes the divergence warm start with the particles,
+// as the CPU does: the same bits, solver state and sweep counts as the CPU's reordering run.
+TEST(Dfsph, HostDeviceReorderingGivesTheCpusBits) {
+  auto d = dam_break(Method::CellIndex);
+  d.cfg.reorder_every = 10;
+  Simulation<2, double> cpu(d.cfg, d.particles);
+  Simulation<2, double> dev(d.cfg, d.particles);
+  dev.use_backend(Backend::HostDevice);
+  for (int k = 0; k < 40; ++k) {
+    cpu.step();
+    dev.step();
+  }
+  EXPECT_EQ(dev.timings().reorders, 4u);
+  EXPECT_TRUE(test::same_state(cpu.particles(), dev.particles()));
+  EXPECT_EQ(cpu.solver_state().dfsph_kappa_v, dev.solver_state().dfsph_kappa_v);
+  EXPECT_EQ(cpu.dfsph_stats().density_iterations, dev.dfsph_stats().density_iterations);
+  EXPECT_EQ(cpu.dfsph_stats().divergence_iterations, dev.dfsph_stats().divergence_iterations);
+}
+
 // 3D float on the device: the same bits as the CPU.
 TEST(Dfsph, HostDeviceIsBitIdenticalToTheCpu3DFloat) {
   using V3 = Vec<3, float>;

@@ -1081,6 +1081,16 @@ void Simulation<Dim, Real>::upload_to_device() {
 // the paper's model with global steps, on the device's copy of the particles.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::step_device() {
+  if (cfg_.reorder_every > 0 && steps_ % cfg_.reorder_every == 0) {
+    // step()'s reorder, on the host's copy: every field comes back, is permuted by the CPU's code and goes
+    // again (the round trip of an emitter's count change), so the device keeps the CPU's order and bits.
+    Stopwatch sw;
+    sync_host();
+    reorder_slots(fluid_);
+    upload_to_device();
+    ++timings_.reorders;
+    timings_.reorder += sw.ms();
+  }
   DeviceStepInput<Real> in{time_, last_dt_, leapfrog_started_};
   if (inflow_activity()) in.emitters_active = active_.data();
   if (cfg_.model == Model::Dfsph) {

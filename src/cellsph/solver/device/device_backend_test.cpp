@@ -336,9 +336,22 @@ TEST(DeviceBackend, UnsupportedConfigsAreInputErrors) {
   per_particle.model = Model::PaperMultiphase;
   per_particle.time.mode = TimeStepping::PerParticle;
   expect_refused(per_particle, "per-particle time steps");
-  auto reorder = cfg;
-  reorder.reorder_every = 10;
-  expect_refused(reorder, "neighbors.reorder_every");
+}
+
+// neighbors.reorder_every on the device: the CPU's permutation on the host's copy, then everything goes up
+// again. The same bits as the CPU's reordering run, slot by slot (ids included); the reorders are counted
+// and did move particles.
+TEST(DeviceBackend, ReorderingGivesTheCpusBits) {
+  auto box = test::weakly_viscous_box(Model::Wcsph, WallModel::Adami, 0.5);
+  box.cfg.reorder_every = 7;
+  expect_same_steps(box.cfg, box.particles, 30);
+  Simulation<2, double> dev(box.cfg, box.particles);
+  dev.use_backend(Backend::HostDevice);
+  for (int s = 0; s < 30; ++s) dev.step();
+  EXPECT_EQ(dev.timings().reorders, 5u);  // steps 0, 7, 14, 21, 28
+  const auto& ids = dev.particles().id;
+  EXPECT_FALSE(std::is_sorted(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(box.fluid_count)))
+      << "no fluid particle changed its slot";
 }
 
 // The two messages of --backend cuda on a machine that cannot run it (this machine and CI have no GPU):

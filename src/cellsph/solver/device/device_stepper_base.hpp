@@ -102,7 +102,6 @@ template <int Dim, class Real>
 std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
-  if (cfg.reorder_every > 0) return "the device keeps the input order; set neighbors.reorder_every to 0";
   if (cfg.rigid_bodies.any() && !(cfg.rigid_bodies.contact_distance < double(cfg.support)))
     return "floating bodies on a device need body_contact.distance below the support h (the device's rows "
            "of body particles reach h)";
