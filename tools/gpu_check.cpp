@@ -133,7 +133,7 @@ void compare_steps(const std::string& name, int steps, double tolerance) {
 
 struct Timing {
   double step_ms = 0, neighbors_ms = 0, dt = 0, bytes_per_particle = 0;
-  std::size_t fluid = 0, total = 0;
+  std::size_t fluid = 0, total = 0, pairs = 0;  // pairs: the device rows' entries (fluid and wall rows)
 };
 
 template <int Dim, class Real>
@@ -154,6 +154,14 @@ Timing time_case(const nlohmann::json& j, Backend backend, int warmup, int steps
   r.fluid = sim.fluid_count();
   r.total = sim.particles().size();
   if (backend == Backend::Cuda) r.bytes_per_particle = double(cuda_memory_in_use() - mem0) / double(r.total);
+  if (backend != Backend::Cpu) {  // the rows of the final state, counted after the timing
+    sim.use_backend(Backend::Cpu);
+    auto dev =
+        backend == Backend::Cuda ? make_cuda_stepper(scene.solver) : make_host_device_stepper(scene.solver);
+    dev->upload(sim.particles());
+    const DeviceRows d = dev->neighbor_rows();
+    r.pairs = d.rows.size() + d.wall_rows.size();
+  }
   return r;
 }
 
@@ -168,8 +176,8 @@ void bench(const std::vector<std::size_t>& sizes, int warmup, int steps, std::si
     volume += e;
   }
   std::printf("\n== bench: dam-break-3d rescaled (spacing s for the fluid count, support 2 s), float ==\n");
-  std::printf("  %-7s %10s %10s %10s %10s %8s %14s %14s %10s\n", "backend", "fluid", "total", "step ms",
-              "search ms", "nbr%", "Mfluid-steps/s", "wall s/sim s", "B/particle");
+  std::printf("  %-7s %10s %10s %10s %10s %8s %14s %14s %10s %12s\n", "backend", "fluid", "total", "step ms",
+              "search ms", "nbr%", "Mfluid-steps/s", "wall s/sim s", "B/particle", "Gpairs/s");
   for (const std::size_t n : sizes) {
     nlohmann::json j = base;
     const double spacing = std::cbrt(volume / double(n));
@@ -180,10 +188,10 @@ void bench(const std::vector<std::size_t>& sizes, int warmup, int steps, std::si
       if (b == Backend::Cpu && n != cpu_size) continue;
       const Timing t =
           time_case<3, float>(j, b, b == Backend::Cpu ? 1 : warmup, b == Backend::Cpu ? 3 : steps);
-      std::printf("  %-7s %10zu %10zu %10.3f %10.3f %7.1f%% %14.2f %14.2f %10.0f\n",
+      std::printf("  %-7s %10zu %10zu %10.3f %10.3f %7.1f%% %14.2f %14.2f %10.0f %12.2f\n",
                   std::string(backend_name(b)).c_str(), t.fluid, t.total, t.step_ms, t.neighbors_ms,
                   100 * t.neighbors_ms / t.step_ms, double(t.fluid) / (t.step_ms * 1e3),
-                  t.step_ms / 1e3 / t.dt, t.bytes_per_particle);
+                  t.step_ms / 1e3 / t.dt, t.bytes_per_particle, double(t.pairs) / (t.neighbors_ms * 1e6));
       std::fflush(stdout);
     }
   }
