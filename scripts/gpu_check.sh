@@ -13,7 +13,8 @@
 #   copies the header-only libraries (nlohmann-json, nanoflann) into gpu_headers/ (ignored by git), which
 #   must travel with the tree (the device tool's `carry`), and build/gpu/cellsph_gpu_check, if it was built
 #   here with the configure line below, into gpu_bin/ (ignored; carry it too to skip the build there).
-# There: scripts/gpu_check.sh        (about 2 min of build on 16 cores, then about 3 min of runs)
+# There: scripts/gpu_check.sh        (about 2 min of build on 16 cores unless gpu_bin/ came; the runs took
+#                                     20-40 s on an H200)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 

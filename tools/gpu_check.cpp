@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -41,6 +42,12 @@ int g_failures = 0;
 // machine without a GPU before device time is spent on it.
 Backend g_device = Backend::Cuda;
 
+// A stepper of the device under check.
+template <int Dim, class Real>
+std::unique_ptr<DeviceStepperBase<Dim, Real>> make_device(const SolverConfig<Dim, Real>& cfg) {
+  return g_device == Backend::Cuda ? make_cuda_stepper(cfg) : make_host_device_stepper(cfg);
+}
+
 void verdict(bool ok, const std::string& what) {
   std::printf("%s %s\n", ok ? "PASS" : "FAIL", what.c_str());
   std::fflush(stdout);
@@ -56,7 +63,7 @@ Scene<Dim, Real> scene_of(const nlohmann::json& j) {
 // the fluid ones).
 template <int Dim, class Real>
 bool rows_equal(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p, std::uint64_t& pairs) {
-  auto dev = g_device == Backend::Cuda ? make_cuda_stepper(cfg) : make_host_device_stepper(cfg);
+  auto dev = make_device(cfg);
   dev->upload(p);
   const DeviceRows d = dev->neighbor_rows();
   NeighborSearch<Dim, Real> search(cfg.search);
@@ -156,8 +163,7 @@ Timing time_case(const nlohmann::json& j, Backend backend, int warmup, int steps
   if (backend == Backend::Cuda) r.bytes_per_particle = double(cuda_memory_in_use() - mem0) / double(r.total);
   if (backend != Backend::Cpu) {  // the rows of the final state, counted after the timing
     sim.use_backend(Backend::Cpu);
-    auto dev =
-        backend == Backend::Cuda ? make_cuda_stepper(scene.solver) : make_host_device_stepper(scene.solver);
+    auto dev = make_device(scene.solver);
     dev->upload(sim.particles());
     const DeviceRows d = dev->neighbor_rows();
     r.pairs = d.rows.size() + d.wall_rows.size();
@@ -291,8 +297,8 @@ int main(int argc, char** argv) {
       dfsph_wall = std::atof(argv[++k]);
     } else {
       std::fprintf(stderr,
-                   "usage: cellsph_gpu_check [--sizes N,N] [--steps N] [--bench-steps N] [--dfsph-until T] "
-                   "[--dfsph-wall S] [--host-device] [--bench-only]\n");
+                   "usage: cellsph_gpu_check [--sizes N,N] [--steps N] [--bench-steps N] [--dfsph-steps N] "
+                   "[--dfsph-until T] [--dfsph-wall S] [--host-device] [--bench-only]\n");
       return 2;
     }
   }
