@@ -24,8 +24,8 @@ const std::vector<Vec<3, float>>& lattice_1e6() {
   return x;
 }
 
-// The other two sets, r = 2 spacings: uniform random points (in random order) and the same
-// kind of points sorted into cell order.
+// The other sets, r = 2 spacings: uniform random points (in random order), the same kind of
+// points sorted into cell order, and eight Gaussian blobs (clustered).
 const std::vector<Vec<3, float>>& uniform_1e6() {
   static const auto x = point_sets::uniform_random<3, float>(1000000, 1.0f);
   return x;
@@ -34,12 +34,25 @@ const std::vector<Vec<3, float>>& uniform_cells_1e6() {
   static const auto x = point_sets::uniform_in_cell_order<3, float>(1000000, 1.0f);
   return x;
 }
+const std::vector<Vec<3, float>>& clustered_1e6() {
+  static const auto x = point_sets::clustered<3, float>(1000000, 1.0f);
+  return x;
+}
 const std::vector<Vec<3, float>>& point_set(std::int64_t set) {
-  return set == 0 ? lattice_1e6() : set == 1 ? uniform_1e6() : uniform_cells_1e6();
+  switch (set) {
+    case 0:
+      return lattice_1e6();
+    case 1:
+      return uniform_1e6();
+    case 2:
+      return uniform_cells_1e6();
+    default:
+      return clustered_1e6();
+  }
 }
 
 // Build + find_all, as `cellsph neighbors` runs it, on warm lists (reused across iterations).
-// Args: subdivision H; set (0 lattice, 1 uniform, 2 uniform in cell order); sorted (1: rows
+// Args: subdivision H; set (0 lattice, 1 uniform, 2 uniform in cell order, 3 clustered); sorted (1: rows
 // ascending, the default; 0: rows in the search's own order, as TreeNSearch leaves them).
 void BM_CellIndexBuildAndLists(benchmark::State& state) {
   ScopedThreads threads(2);
@@ -77,9 +90,11 @@ BENCHMARK(BM_CellIndexBuildAndLists)
     ->Args({3, 0, 1})
     ->Args({1, 1, 1})
     ->Args({1, 2, 1})
+    ->Args({1, 3, 1})
     ->Args({1, 0, 0})
     ->Args({1, 1, 0})
     ->Args({1, 2, 0})
+    ->Args({1, 3, 0})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
