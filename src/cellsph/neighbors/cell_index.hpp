@@ -194,7 +194,7 @@ class CellIndex {
   using Point = Vec<Dim, Real>;
 
   explicit CellIndex(const SearchOptions& opt = {})
-      : subdivision_(opt.subdivision), sorted_rows_(opt.sorted_rows) {
+      : subdivision_(opt.subdivision), sorted_rows_(opt.sorted_rows), zero_rows_(opt.zero_support_rows) {
     if (subdivision_ < 1) {
       std::ostringstream os;
       os << "cell-index: subdivision H must be >= 1, got " << subdivision_;
@@ -1123,6 +1123,10 @@ class CellIndex {
             static_cast<std::uint32_t>(std::lower_bound(cells, cells + nc, cells[u0] + deltas_[m]) - cells);
       std::uint64_t local_tests = 0;
       for (std::size_t u = u0; u < u1; ++u) {
+        if (zero_cell_[u] && !zero_rows_) {
+          for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) kernel(p, Block{}, masks(p, 0));
+          continue;  // the cursors catch up at the next cell, as below
+        }
         if (zero_cell_[u]) {
           // Support 0: the neighbours are the points at distance 0, which share the home cell (a
           // cell is a function of the position). The cursors skip this cell; the next cell's
@@ -1184,6 +1188,8 @@ class CellIndex {
             gathered = true;
             local_tests += total - 1;
             kernel(p, home_blk, masks(p, total));
+          } else if (!zero_rows_ && hs_[p] == 0) {
+            kernel(p, Block{}, masks(p, 0));  // an empty row, not searched (zero_support_rows)
           } else {
             // Smaller support: only the mask cells that can reach within h_p (section 4.1).
             const double reach = double(hs_[p]) / cell_size_;
@@ -1234,6 +1240,7 @@ class CellIndex {
 
   int subdivision_ = 1;
   bool sorted_rows_ = true;
+  bool zero_rows_ = true;  // SearchOptions::zero_support_rows
   bool avx2_ = detail::cpu_has_avx2();
   bool force_wide_ = false;
   std::uint32_t kept_order_max_ = kKeptOrderMax;

@@ -366,6 +366,65 @@ TEST(CellIndex, LongBlocksKeepTheirHitMasksInTheSpill) {
   }
 }
 
+// SearchOptions::zero_support_rows = false (the solver's walls): the rows of points of support 0 are
+// empty, every other row is the exact one, in cells of support-0 points only and in cells shared with
+// points of full support; the default lists their exact duplicates, as all-pairs does.
+template <class Real>
+void expect_zero_support_rows_left_empty() {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Points<3, Real> x;
+  std::vector<Real> h;
+  for (int i = 0; i < 3000; ++i) {  // "fluid" in [0, 6)^3, "walls" in [4, 10)^3: both alone and mixed
+    x.push_back({{Real(6 * u(rng)), Real(6 * u(rng)), Real(6 * u(rng))}});
+    h.push_back(Real(1));
+    x.push_back({{Real(4 + 6 * u(rng)), Real(4 + 6 * u(rng)), Real(4 + 6 * u(rng))}});
+    h.push_back(Real(0));
+  }
+  for (int i = 0; i < 20; ++i) {  // duplicates: of a wall point and of a fluid point, with support 0
+    x.push_back(x[static_cast<std::size_t>(2 * i + 1)]);
+    h.push_back(Real(0));
+    x.push_back(x[static_cast<std::size_t>(2 * i)]);
+    h.push_back(Real(0));
+  }
+  const NeighborList ref = all_pairs<3, Real>(x, h);
+  for (const bool sorted : {true, false}) {
+    CellIndex<3, Real> ci({.sorted_rows = sorted, .zero_support_rows = false});
+    ci.build(x, h);
+    NeighborList nl;
+    ci.find_all(nl);
+    std::vector<std::uint64_t> counts;
+    const std::uint64_t pairs = ci.count_pairs(counts);
+    std::uint64_t expected = 0, duplicates = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if (h[i] == 0) {
+        EXPECT_EQ(nl.count(i), 0u) << i;
+        duplicates += ref.count(i);
+        continue;
+      }
+      std::vector<std::uint32_t> row(nl.begin(i), nl.end(i)), want(ref.begin(i), ref.end(i));
+      if (!sorted) std::sort(row.begin(), row.end());
+      EXPECT_EQ(row, want) << i;
+      EXPECT_EQ(counts[i], want.size()) << i;
+      expected += want.size();
+    }
+    EXPECT_EQ(pairs, expected);
+    EXPECT_GE(duplicates, 40u) << "the set should hold support-0 points with duplicates";
+  }
+  CellIndex<3, Real> all;  // the default keeps them
+  all.build(x, h);
+  NeighborList nl;
+  all.find_all(nl);
+  EXPECT_EQ(nl.offsets, ref.offsets);
+  EXPECT_EQ(nl.indices, ref.indices);
+}
+TEST(CellIndex, ZeroSupportRowsLeftEmptyOnRequestFloat) {
+  expect_zero_support_rows_left_empty<float>();
+}
+TEST(CellIndex, ZeroSupportRowsLeftEmptyOnRequestDouble) {
+  expect_zero_support_rows_left_empty<double>();
+}
+
 // L distinct values: from [0, small) on even draws, from the whole unsigned range on odd ones.
 [[maybe_unused]] std::vector<std::uint32_t> distinct_values(std::mt19937& rng, std::uint32_t L, int rep,
                                                             std::uint32_t small) {

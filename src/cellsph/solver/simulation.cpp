@@ -65,11 +65,18 @@ std::uint64_t morton_key(const std::uint64_t (&c)[Dim]) {
   return key;
 }
 
+// The step's search: the wall particles search with support 0 (search_h_) and no pass reads their rows,
+// so Cell Indexing leaves them empty instead of searching them.
+SearchOptions step_search(SearchOptions o) {
+  o.zero_support_rows = false;
+  return o;
+}
+
 }  // namespace
 
 template <int Dim, class Real>
 Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
-    : cfg_(std::move(config)), p_(std::move(particles)), search_(cfg_.search) {
+    : cfg_(std::move(config)), p_(std::move(particles)), search_(step_search(cfg_.search)) {
   cfg_.validate();
   for (const auto& ph : cfg_.phases) phase_params_.push_back({ph.rest_density, ph.viscosity, ph.sigma});
   const std::size_t n = p_.x.size();
