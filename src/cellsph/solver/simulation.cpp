@@ -204,12 +204,14 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   // Default 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
   skin_ = cfg_.verlet_skin * cfg_.support;
   search_h_.assign(n, Real(0));
+  bare_h_.assign(n, Real(0));
   for (std::size_t i = 0; i < n; ++i) {
     if (p_.kind[i] != kFluid) {
       boundary_.push_back(static_cast<std::uint32_t>(i));
       continue;
     }
     fluid_.push_back(static_cast<std::uint32_t>(i));
+    bare_h_[i] = p_.h[i];
     search_h_[i] = p_.h[i] + skin_;
   }
   // Boundary particles never move: one reorder puts them in cell order for the whole run (before their
@@ -230,7 +232,10 @@ void Simulation<Dim, Real>::set_body_slots(bool place) {
   if (wall_a_.size() != p_.size()) wall_a_.assign(p_.size(), V{});
   // Their rows hold their fluid neighbours (within h: the reaction) and the walls they touch.
   const Real radius = std::max(cfg_.support, static_cast<Real>(cfg_.rigid_bodies.contact_distance));
-  for (const std::uint32_t b : bodies_.slots()) search_h_[b] = radius + skin_;
+  for (const std::uint32_t b : bodies_.slots()) {
+    bare_h_[b] = radius;
+    search_h_[b] = radius + skin_;
+  }
   if (place) bodies_.place(p_.x, p_.v, wall_a_);
   lists_valid_ = false;
 }
@@ -389,6 +394,7 @@ void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
   // Every member array that persists between steps (the others are rebuilt before they are read).
   permute(rho0_);
   permute(search_h_);
+  permute(bare_h_);
   permute(vol_);
   permute(prho2_);
   permute(f_pressure_);
@@ -428,9 +434,6 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
   if (skin_ > 0 && bare_searches_ > 0) {
     --bare_searches_;
     ++timings_.bare_builds;
-    bare_h_.resize(search_h_.size());
-    for (std::size_t i = 0; i < search_h_.size(); ++i)
-      bare_h_[i] = search_h_[i] > 0 ? search_h_[i] - skin_ : Real(0);
     search_.build(std::span<const V>(p_.x), std::span<const Real>(bare_h_));
     search_.find_all(nl_);
     lists_valid_ = false;  // rows within h only: the next step searches again
@@ -746,6 +749,7 @@ void Simulation<Dim, Real>::rebuild_kind_lists() {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
     const bool fluid = p_.kind[i] == kFluid;
     (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
+    bare_h_[i] = fluid ? p_.h[i] : Real(0);
     search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
   }
   fluid_count_ = fluid_.size();
@@ -863,6 +867,7 @@ void Simulation<Dim, Real>::change_count(const std::vector<std::uint8_t>& keep, 
   state_.for_each_field([&](std::string_view, auto& field) { edit(field); });
   edit(rho0_);
   edit(search_h_);
+  edit(bare_h_);
   edit(vol_);
   edit(prho2_);
   edit(f_pressure_);
@@ -1018,6 +1023,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   if (f_pressure_.size() != n) f_pressure_.assign(n, V{});
   rho0_.resize(n);
   search_h_.resize(n);
+  bare_h_.resize(n);
   rebuild_kind_lists();
   state_ = std::move(solver);
   if (inflow) {

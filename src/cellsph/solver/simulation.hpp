@@ -276,7 +276,8 @@ class Simulation {
   Real skin_ = 0;
   bool lists_valid_ = false;
   // Steps the current lists have been kept; when skinned lists do not last one step, the next
-  // kBareSearches searches run at the bare supports (bare_h_: search_h_ less the skin), whose rows hold
+  // kBareSearches searches run at the bare supports (bare_h_: h for fluid, the bodies' radius, 0 for walls;
+  // kept beside search_h_, not computed as search_h_ less the skin, which can round below h), whose rows hold
   // the same pairs within h. The schedule changes the speed only, never a result.
   std::uint32_t lists_kept_ = 0;
   std::uint32_t bare_searches_ = 0;
