@@ -71,10 +71,10 @@ struct ParticleView {
 
   // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +
   // 1]. The rows cut to h (filter_rows): within + offsets[i], within_count[i] long; the pair passes read
-  // these.
+  // these. Rows searched at h itself need no cut: within is then the candidates.
   const std::uint64_t* offsets = nullptr;
   const std::uint32_t* candidates = nullptr;
-  std::uint32_t* within = nullptr;
+  const std::uint32_t* within = nullptr;
   std::uint32_t* within_count = nullptr;
 
   // Wall particles' fluid neighbours (Adami and dynamic walls, boundary/wall_neighbors.hpp): CSR by particle

@@ -141,10 +141,17 @@ TEST(PassDriver, ReduceSumAddsInFixedBlocksWhateverTheThreadCount) {
   EXPECT_EQ(reduce_sum(IndexSet{}, pass), 0.0);
 }
 
+// Rows searched at h itself are used as they are: only their lengths are written.
+TEST(Passes, RowLengthPassCountsRowsAsTheyAre) {
+  Line l;
+  run_pass(IndexSet{0, 1, 2}, RowLengthPass<2, double>{l.view()});
+  EXPECT_EQ(l.count, (std::vector<std::uint32_t>{2, 2, 2}));
+}
+
 TEST(Passes, FilterRowsAndSummationDensityOnAHandMadeView) {
   Line l;
   const IndexSet all{0, 1, 2};
-  run_pass(all, FilterRowsPass<2, double>{l.view()});
+  run_pass(all, FilterRowsPass<2, double>{l.view(), l.within.data()});
   EXPECT_EQ(l.count, (std::vector<std::uint32_t>{2, 2, 0}));
   EXPECT_EQ(l.within[0], 1u);
   EXPECT_EQ(l.within[1], 2u);

@@ -332,7 +332,7 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.cg_active = cg_active_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
-  v.within = within_.data();
+  v.within = rows_at_h_ ? nl_.indices.data() : within_.data();
   v.within_count = within_count_.data();
   v.wall_start = walls_.start.data();
   v.wall_nbr = walls_.nbr.data();
@@ -411,6 +411,7 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     search_.build(std::span<const V>(p_.x), std::span<const Real>(p_.h));
     search_.find_all(nl_);
     lists_valid_ = false;
+    rows_at_h_ = true;
     return;
   }
   if (lists_valid_ && skin_ > 0) {
@@ -437,10 +438,12 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     search_.build(std::span<const V>(p_.x), std::span<const Real>(bare_h_));
     search_.find_all(nl_);
     lists_valid_ = false;  // rows within h only: the next step searches again
+    rows_at_h_ = true;
     return;
   }
   search_.build(std::span<const V>(p_.x), std::span<const Real>(search_h_));
   search_.find_all(nl_);
+  rows_at_h_ = skin_ == 0;
   if (skin_ > 0) x_built_ = p_.x;
   lists_valid_ = true;
   lists_kept_ = 0;
@@ -449,9 +452,13 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
 // The rows of `set` cut down to the pairs within h_i (verlet_rows.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::filter_lists(const IndexList& set) {
-  within_.resize(nl_.indices.size());
   within_count_.resize(p_.size());
-  run_pass(set, FilterRowsPass<Dim, Real>{view()});
+  if (rows_at_h_) {
+    run_pass(set, RowLengthPass<Dim, Real>{view()});  // the rows are the candidates (view())
+    return;
+  }
+  within_.resize(nl_.indices.size());
+  run_pass(set, FilterRowsPass<Dim, Real>{view(), within_.data()});
 }
 
 // Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state

@@ -283,6 +283,9 @@ class Simulation {
   std::uint32_t bare_searches_ = 0;
   static constexpr std::uint32_t kBareSearches = 16;
   std::vector<Real> bare_h_;
+  // The last search ran at the bare supports (or without a skin): its rows hold exactly the pairs within h,
+  // so filter_lists() only counts them and the passes read the candidates (verlet_rows.hpp).
+  bool rows_at_h_ = false;
   bool any_tension_ = false;
   // WallModel::Adami or Dynamic and there are boundary particles: walls carry their own p, rho (and
   // velocity for no slip), computed each step by compute_wall_states.
