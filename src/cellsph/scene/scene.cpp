@@ -485,7 +485,13 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   }
   auto sr = r.child("solver");
   cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph", "dfsph"}));
-  if (cfg.model == Model::Dfsph) cfg.time.courant = Real(0.4);  // on the particle diameter (models/dfsph.hpp)
+  if (cfg.model == Model::Dfsph) {
+    cfg.time.courant = Real(0.4);  // on the particle diameter (models/dfsph.hpp)
+    // A CFL step moves the fastest particle 0.4 d, more than 0.45 of any skin that lengthens the rows
+    // little, so skinned lists seldom last a step; without the skin the rows, the stored gradients and the
+    // row cut take a third less memory (docs/benchmarks.md, "gradient vectors").
+    cfg.verlet_skin = Real(0);
+  }
   cfg.backend = *parse_backend(sr.choice("backend", "cpu", {"cpu", "cuda", "host-device"}));
   cfg.support = static_cast<Real>(sr.number("support", 2 * spacing, 1e-9, 1e9));
   if (cfg.support < static_cast<Real>(spacing))

@@ -69,6 +69,22 @@ TEST(Scene, OpenTopWallsOpenTheFaceGravityPointsAwayFrom) {
   EXPECT_EQ(beyond_z, 12 * 11);  // the z = 1.05 face: x in -0.05..1.05 (12), y in -0.05..0.95 (11)
 }
 
+// The Verlet skin defaults to 0.15 h, and to 0 under DFSPH (whose CFL steps outrun it); a scene's own
+// neighbors.skin wins either way.
+TEST(Scene, SkinDefaultsToZeroUnderDfsphOnly) {
+  auto skin = [](const nlohmann::json& j) {
+    return load_scene<2, double>(j, "scene.json").solver.verlet_skin;
+  };
+  EXPECT_DOUBLE_EQ(skin(nlohmann::json::parse(kMinimal)), 0.15);
+  EXPECT_DOUBLE_EQ(skin(with(kMinimal, "/solver/model", "wcsph")), 0.15);
+  const auto dfsph = with(kMinimal, "/solver/model", "dfsph");
+  EXPECT_DOUBLE_EQ(skin(dfsph), 0.0);
+  auto j = dfsph;
+  j["neighbors"]["skin"] = 0.3;
+  EXPECT_DOUBLE_EQ(skin(j), 0.3);
+  EXPECT_DOUBLE_EQ(skin(with(kMinimal, "/neighbors/skin", 0.25)), 0.25);
+}
+
 TEST(Scene, BlockIsFilledAtLatticeCentresWithPhaseMass) {
   const auto j = nlohmann::json::parse(kMinimal);
   const auto s = load_scene<2, double>(j, "scene.json");

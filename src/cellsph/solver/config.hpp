@@ -244,6 +244,7 @@ struct SolverConfig {
   SearchOptions search{};
   // Verlet lists: the search runs at h (1 + verlet_skin) and its lists are kept until a particle has moved
   // 0.45 of the skin. 0: a search every step. Results do not depend on it (pairs are re-filtered at h).
+  // Scenes with /solver/model = "dfsph" default to 0 (scene.cpp, read_solver).
   Real verlet_skin = Real(0.15);
   // Every this many steps the fluid particles' arrays are permuted into cell order (Z-order of cells of
   // size h, ties by id), so that neighbours sit near each other in memory; 0: never (input order kept).

@@ -57,8 +57,7 @@ struct ParticleView {
   Real* df_alpha = nullptr;       // DFSPH (models/dfsph.hpp): 1 / (the factor's denominator)
   Real* df_kappa = nullptr;       // DFSPH: this sweep's pressure / rho^2 increment
   Real* df_kappa_v = nullptr;     // DFSPH: the divergence solve's pressure / rho^2 (warm start)
-  Real* df_grad = nullptr;        // DFSPH: W'(r)/r of each pair of the rows (grad W = x_ij times it), at the
-                                  // pair's slot in `within`
+  V* df_grad = nullptr;           // DFSPH: grad W_ij of each pair of the rows, at the pair's slot in `within`
   V* df_gsum = nullptr;           // DFSPH: sum_j w_ij grad W_ij of the step (the density pass)
   V* df_gwall = nullptr;          // DFSPH: its walls' part, sum_b w_ib grad W_ib
   V* df_mv = nullptr;             // DFSPH: w_j v_j (the mass density's sweeps gather it)

@@ -322,9 +322,9 @@ class Simulation {
   mutable SolverState<Dim, Real> state_;  // mutable: copied back from a device with the particles
   // Model::Dfsph (models/dfsph.hpp): alpha and the sweep's k are rebuilt each step.
   std::vector<Real> df_alpha_, df_kappa_;
-  // Per pair slot of the rows (nl_.indices.size()): the step's kernel gradients as W'(r)/r (one scalar,
-  // not the vector: a third of the bytes in 3D; the vector is x_ij times it).
-  std::vector<Real> df_grad_;
+  // Per pair slot of the rows (nl_.indices.size()): the step's kernel gradients (the vectors: the sweeps
+  // read them in order, where a scalar W'(r)/r would have them gather x_j; docs/benchmarks.md).
+  std::vector<V> df_grad_;
   std::vector<V> df_gsum_, df_gwall_, df_mv_;  // DFSPH: per-step sums and the sweeps' gathered w_j v_j
   std::vector<Real> df_mk_;                    // DFSPH: the sweeps' gathered m_j k_j
   std::vector<V> cg_v0_;                       // DFSPH's CG density solve (models/dfsph_cg.hpp)

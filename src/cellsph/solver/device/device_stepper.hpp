@@ -450,8 +450,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<std::uint32_t> fluid_, boundary_, identity_;
   std::vector<std::uint32_t> fluid_host_;
   Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
-  Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_grad_, df_mk_;  // DFSPH (models/dfsph.hpp)
-  Array<V> df_gsum_, df_gwall_, df_mv_;
+  Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_mk_;  // DFSPH (models/dfsph.hpp)
+  Array<V> df_grad_, df_gsum_, df_gwall_, df_mv_;
   Array<Real> cg_s_, cg_p_, cg_ap_;  // DFSPH's CG density solve (models/dfsph_cg.hpp)
   Array<V> cg_v0_;
   Array<std::uint8_t> cg_active_;

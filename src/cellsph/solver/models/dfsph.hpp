@@ -81,12 +81,12 @@ struct DfsphStats {
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
 };
 
-// The step's kernel gradient of the pair at row slot `it` of i: x_ij times the scalar the density pass
-// stored (df_grad; positions do not change during the solves, and x_ij * gradW_factor has gradW's bits).
+// The step's kernel gradient of the pair at row slot `it` of i, as the density pass stored it (df_grad;
+// positions do not change during the solves, and x_ij * gradW_factor has gradW's bits). Stored as the
+// vector, not as the scalar W'(r)/r: a sweep's pair then reads it in order instead of gathering x_j.
 template <int Dim, class Real>
-CELLSPH_HD inline Vec<Dim, Real> dfsph_grad(const ParticleView<Dim, Real>& pv, const Vec<Dim, Real>& xi,
-                                            const std::uint32_t* it) {
-  return (xi - pv.x[*it]) * pv.df_grad[it - pv.within];
+CELLSPH_HD inline Vec<Dim, Real> dfsph_grad(const ParticleView<Dim, Real>& pv, const std::uint32_t* it) {
+  return pv.df_grad[it - pv.within];
 }
 
 // The weight a neighbour j carries in i's density rho_i = sum_j w_ij W_ij: m_j for the mass density; for the
@@ -104,11 +104,11 @@ CELLSPH_HD inline Real dfsph_weight(const ParticleView<Dim, Real>& pv, bool numb
 // rows, with the step's gradients (df_grad, written by the density pass).
 template <int Dim, class Real>
 CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i, bool number) {
-  const Vec<Dim, Real> xi = pv.x[i], vi = pv.v[i];
+  const Vec<Dim, Real> vi = pv.v[i];
   Real d = 0;
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
     const std::uint32_t j = *it;
-    d += continuity_term(dfsph_grad(pv, xi, it), dfsph_weight(pv, number, i, j), vi - pv.v[j]);
+    d += continuity_term(dfsph_grad(pv, it), dfsph_weight(pv, number, i, j), vi - pv.v[j]);
   }
   return d;
 }
@@ -116,10 +116,9 @@ CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std
 // The same rate regrouped for the mass density (the header): v_i . G_i - sum_j (w_j v_j) . grad W_ij.
 template <int Dim, class Real>
 CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>& pv, std::size_t i) {
-  const Vec<Dim, Real> xi = pv.x[i];
   Real d = dot(pv.v[i], pv.df_gsum[i]);
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
-    d -= dot(pv.df_mv[*it], dfsph_grad(pv, xi, it));
+    d -= dot(pv.df_mv[*it], dfsph_grad(pv, it));
   return d;
 }
 
@@ -201,12 +200,13 @@ struct DfsphDensityFactorPass {
       const V xij = xi - pv.x[*it];
       const auto k = kernel_value_and_factor(w, xij, norm2(xij));
       rho += dfsph_weight(pv, number, i, *it) * k.value;  // density_term(w, w_ij, |x_ij|^2), bit for bit
-      pv.df_grad[it - pv.within] = k.factor;  // the step's gradients, read by every sweep (positions fixed)
+      pv.df_grad[it - pv.within] =
+          xij * k.factor;  // the step's gradients, read by every sweep (positions fixed)
     }
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
       const Real wj = dfsph_weight(pv, number, i, j);
-      const V g = dfsph_grad(pv, xi, it);  // = w.gradW(x_ij), bit for bit
+      const V g = dfsph_grad(pv, it);  // = w.gradW(x_ij), bit for bit
       const V mg = g * wj;
       grad += mg;
       if (!number) mv_sum += dot(pv.df_mv[j], g);
@@ -257,12 +257,11 @@ struct DfsphPressureKickPass {
   CELLSPH_HD void operator()(std::size_t i) const {
     using V = Vec<Dim, Real>;
     const Real mi = pv.m[i], ki = pv.df_kappa[i];
-    const V xi = pv.x[i];
     if (acc) acc[i] += ki;  // null: a kick that is not part of the solve's sum (models/dfsph_cg.hpp)
     if (!number) {          // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
       V s = (mirror ? V(pv.df_gsum[i] + pv.df_gwall[i]) : pv.df_gsum[i]) * ki;
       for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
-        s += dfsph_grad(pv, xi, it) * pv.df_mk[*it];
+        s += dfsph_grad(pv, it) * pv.df_mk[*it];
       pv.v[i] -= s * dt;
       pv.df_mv[i] = pv.v[i] * mi;
       return;
@@ -271,9 +270,9 @@ struct DfsphPressureKickPass {
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
       const std::uint32_t j = *it;
       if (number && pv.is_fluid(j))
-        f += number_density_pressure_force(dfsph_grad(pv, xi, it), mi, pv.m[j], ki, pv.df_kappa[j]);
+        f += number_density_pressure_force(dfsph_grad(pv, it), mi, pv.m[j], ki, pv.df_kappa[j]);
       else
-        f += symmetric_pressure_force(dfsph_grad(pv, xi, it), mi, dfsph_weight(pv, number, i, j), ki,
+        f += symmetric_pressure_force(dfsph_grad(pv, it), mi, dfsph_weight(pv, number, i, j), ki,
                                       pv.is_fluid(j) ? pv.df_kappa[j]
                                       : mirror       ? ki
                                                      : Real(0));
@@ -304,7 +303,7 @@ struct DfsphNonPressurePass {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
       const Real r2 = norm2(xij);
-      const V g = xij * pv.df_grad[it - pv.within];
+      const V g = dfsph_grad(pv, it);
       if (pv.is_fluid(j)) {
         f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
         continue;
