@@ -81,12 +81,14 @@ struct DfsphStats {
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
 };
 
-// The step's kernel gradient of the pair at row slot `it` of i, as the density pass stored it (df_grad;
-// positions do not change during the solves, and x_ij * gradW_factor has gradW's bits). Stored as the
-// vector, not as the scalar W'(r)/r: a sweep's pair then reads it in order instead of gathering x_j.
+// The step's kernel gradients of i's row, as the density pass stored them (df_grad, one per slot of the
+// row, in its order; positions do not change during the solves, and x_ij * gradW_factor has gradW's
+// bits). Stored as vectors, not as the scalar W'(r)/r: a sweep's pair then reads its gradient in order
+// instead of gathering x_j. The loops walk this pointer beside the row's: one increment a pair, where
+// indexing by the row slot cost the pair loop four more instructions.
 template <int Dim, class Real>
-CELLSPH_HD inline Vec<Dim, Real> dfsph_grad(const ParticleView<Dim, Real>& pv, const std::uint32_t* it) {
-  return pv.df_grad[it - pv.within];
+CELLSPH_HD inline Vec<Dim, Real>* dfsph_row_grads(const ParticleView<Dim, Real>& pv, std::size_t i) {
+  return pv.df_grad + (pv.row_begin(i) - pv.within);
 }
 
 // The weight a neighbour j carries in i's density rho_i = sum_j w_ij W_ij: m_j for the mass density; for the
@@ -106,9 +108,10 @@ template <int Dim, class Real>
 CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i, bool number) {
   const Vec<Dim, Real> vi = pv.v[i];
   Real d = 0;
-  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+  const Vec<Dim, Real>* g = dfsph_row_grads(pv, i);
+  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) {
     const std::uint32_t j = *it;
-    d += continuity_term(dfsph_grad(pv, it), dfsph_weight(pv, number, i, j), vi - pv.v[j]);
+    d += continuity_term(*g, dfsph_weight(pv, number, i, j), vi - pv.v[j]);
   }
   return d;
 }
@@ -117,8 +120,8 @@ CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std
 template <int Dim, class Real>
 CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>& pv, std::size_t i) {
   Real d = dot(pv.v[i], pv.df_gsum[i]);
-  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
-    d -= dot(pv.df_mv[*it], dfsph_grad(pv, it));
+  const Vec<Dim, Real>* g = dfsph_row_grads(pv, i);
+  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) d -= dot(pv.df_mv[*it], *g);
   return d;
 }
 
@@ -196,17 +199,18 @@ struct DfsphDensityFactorPass {
     Real sq = 0, mv_sum = 0;
     // Two loops over the row, the second reading back the first's gradients: one loop kept too many sums
     // live for the registers, and it carried them through memory (measured).
-    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+    V* gw = dfsph_row_grads(pv, i);  // the step's gradients, read by every sweep (positions fixed)
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gw) {
       const V xij = xi - pv.x[*it];
       const auto k = kernel_value_and_factor(w, xij, norm2(xij));
       rho += dfsph_weight(pv, number, i, *it) * k.value;  // density_term(w, w_ij, |x_ij|^2), bit for bit
-      pv.df_grad[it - pv.within] =
-          xij * k.factor;  // the step's gradients, read by every sweep (positions fixed)
+      *gw = xij * k.factor;                               // = w.gradW(x_ij), bit for bit
     }
-    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+    const V* gr = dfsph_row_grads(pv, i);
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gr) {
       const std::uint32_t j = *it;
       const Real wj = dfsph_weight(pv, number, i, j);
-      const V g = dfsph_grad(pv, it);  // = w.gradW(x_ij), bit for bit
+      const V g = *gr;
       const V mg = g * wj;
       grad += mg;
       if (!number) mv_sum += dot(pv.df_mv[j], g);
@@ -260,19 +264,20 @@ struct DfsphPressureKickPass {
     if (acc) acc[i] += ki;  // null: a kick that is not part of the solve's sum (models/dfsph_cg.hpp)
     if (!number) {          // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
       V s = (mirror ? V(pv.df_gsum[i] + pv.df_gwall[i]) : pv.df_gsum[i]) * ki;
-      for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it)
-        s += dfsph_grad(pv, it) * pv.df_mk[*it];
+      const V* g = dfsph_row_grads(pv, i);
+      for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) s += *g * pv.df_mk[*it];
       pv.v[i] -= s * dt;
       pv.df_mv[i] = pv.v[i] * mi;
       return;
     }
     V f{};
-    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+    const V* g = dfsph_row_grads(pv, i);
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) {
       const std::uint32_t j = *it;
       if (number && pv.is_fluid(j))
-        f += number_density_pressure_force(dfsph_grad(pv, it), mi, pv.m[j], ki, pv.df_kappa[j]);
+        f += number_density_pressure_force(*g, mi, pv.m[j], ki, pv.df_kappa[j]);
       else
-        f += symmetric_pressure_force(dfsph_grad(pv, it), mi, dfsph_weight(pv, number, i, j), ki,
+        f += symmetric_pressure_force(*g, mi, dfsph_weight(pv, number, i, j), ki,
                                       pv.is_fluid(j) ? pv.df_kappa[j]
                                       : mirror       ? ki
                                                      : Real(0));
@@ -299,11 +304,12 @@ struct DfsphNonPressurePass {
     const V xi = pv.x[i], vi = pv.v[i];
     const Real vol_i = pv.vol[i], mui = pv.mu[i], rhoi = pv.rho[i];
     V f = gravity * pv.m[i];
-    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it) {
+    const V* gr = dfsph_row_grads(pv, i);
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gr) {
       const std::uint32_t j = *it;
       const V xij = xi - pv.x[j];
       const Real r2 = norm2(xij);
-      const V g = dfsph_grad(pv, it);
+      const V g = *gr;
       if (pv.is_fluid(j)) {
         f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
         continue;
