@@ -487,9 +487,10 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph", "dfsph"}));
   if (cfg.model == Model::Dfsph) {
     cfg.time.courant = Real(0.4);  // on the particle diameter (models/dfsph.hpp)
-    // A CFL step moves the fastest particle 0.4 d, more than 0.45 of any skin that lengthens the rows
-    // little, so skinned lists seldom last a step; without the skin the rows, the stored gradients and the
-    // row cut take a third less memory (docs/benchmarks.md, "gradient vectors").
+    // A CFL step moves the fastest particle 0.4 d, three times the 0.45 of the default skin after which
+    // the lists are rebuilt, so skinned lists seldom last a step; without the skin the rows, the stored
+    // gradients and the row cut take less memory (peak heap 1.17x WCSPH's against 1.64x with the default
+    // skin; docs/benchmarks.md, DFSPH in 3D, "The gradients stored as vectors again").
     cfg.verlet_skin = Real(0);
   }
   cfg.backend = *parse_backend(sr.choice("backend", "cpu", {"cpu", "cuda", "host-device"}));
