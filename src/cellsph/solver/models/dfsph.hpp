@@ -200,12 +200,38 @@ struct DfsphDensityFactorPass {
     // Two loops over the row, the second reading back the first's gradients: one loop kept too many sums
     // live for the registers, and it carried them through memory (measured).
     V* gw = dfsph_row_grads(pv, i);  // the step's gradients, read by every sweep (positions fixed)
+#if defined(__CUDA_ARCH__)
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gw) {
       const V xij = xi - pv.x[*it];
       const auto k = kernel_value_and_factor(w, xij, norm2(xij));
       rho += dfsph_weight(pv, number, i, *it) * k.value;  // density_term(w, w_ij, |x_ij|^2), bit for bit
       *gw = xij * k.factor;                               // = w.gradW(x_ij), bit for bit
     }
+#else
+    // On the host the row goes in blocks, its kernel evaluated in a loop of its own that the compiler
+    // vectorizes: the square root and the division four pairs at a time, each lane with the scalar code's
+    // bits (IEEE operations, no contraction); the sum stays in row order.
+    constexpr int kBlock = 32;
+    Real r2b[kBlock], valb[kBlock], facb[kBlock];
+    for (const auto *it = pv.row_begin(i), *end = pv.row_end(i); it != end;) {
+      const int n = static_cast<int>(end - it < kBlock ? end - it : kBlock);
+      for (int t = 0; t < n; ++t) {
+        gw[t] = xi - pv.x[it[t]];  // x_ij, times the factor below
+        r2b[t] = norm2(gw[t]);
+      }
+      for (int t = 0; t < n; ++t) {
+        const auto k = kernel_value_and_factor(w, gw[t], r2b[t]);
+        valb[t] = k.value;
+        facb[t] = k.factor;
+      }
+      for (int t = 0; t < n; ++t) {
+        rho += dfsph_weight(pv, number, i, it[t]) * valb[t];  // density_term(w, w_ij, |x_ij|^2), bit for bit
+        gw[t] = gw[t] * facb[t];                              // = w.gradW(x_ij), bit for bit
+      }
+      it += n;
+      gw += n;
+    }
+#endif
     const V* gr = dfsph_row_grads(pv, i);
     for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gr) {
       const std::uint32_t j = *it;
