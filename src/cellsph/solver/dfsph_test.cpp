@@ -395,7 +395,7 @@ TEST(Dfsph, SmallColumn2DFloat) {
 }
 
 // The density pass takes a row's kernel in blocks of 32 pairs on the host, in a loop the compiler vectorizes
-// (models/dfsph.hpp). With a support of 3 spacings the rows hold up to 122 pairs, four blocks: every density
+// (models/dfsph.hpp). With a support of 3 spacings the rows hold up to 111 pairs, four blocks: every density
 // equals the sum of the kernel's own W2 over the particle's neighbours in index order, bit for bit, and a
 // double-precision sum within 1e-5.
 TEST(Dfsph, DensityPassSumsLongRowsWithTheKernelsBits) {
