@@ -16,6 +16,8 @@
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/initial.hpp"
+#include "cellsph/solver/models/dfsph.hpp"
+#include "cellsph/solver/pass_driver.hpp"
 #include "cellsph/solver/simulation.hpp"
 #include "cellsph/solver/solver_test_util.hpp"
 
@@ -437,6 +439,116 @@ TEST(Dfsph, DensityPassSumsLongRowsWithTheKernelsBits) {
   EXPECT_GT(longest, std::size_t{96}) << "rows should span more than three blocks";
   EXPECT_EQ(mismatches, 0u) << "densities that differ from the scalar sum";
   EXPECT_LT(worst, 1e-5);
+}
+
+// The divergence solve's last source pass sums the non-pressure forces in the same walk over the rows
+// (DfsphSourceForcesPass): its forces, rate, k and returned error must be those of DfsphNonPressurePass and
+// DfsphSourcePass run one after the other, bit for bit, for both density kinds, with wall neighbours (no
+// slip, hydrostatic wall pressure, a moving wall's acceleration) and rows of every length. The state is
+// made up (random gradients and velocities on a jittered set), so every term carries its own value.
+TEST(Dfsph, SourcePassWithTheForcesGivesTheSeparatePassesBits) {
+  using V = Vec<3, float>;
+  const std::size_t n = 110;
+  const float h = 0.3f;
+  std::vector<V> x(n), v(n), gsum(n), gwall(n), mv(n), wall_a(n), f_alone(n), f_fused(n);
+  std::vector<float> m(n), rho(n), mu(n), rho0(n), vol(n), alpha(n), mk(n), acc(n, 0.0f);
+  std::vector<std::uint8_t> kind(n);
+  std::uint32_t seed = 12345;
+  auto rnd = [&] {  // in [-1, 1)
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1u << 23) - 1.0f;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const float spread = i < 100 ? 0.4f : 2.0f;  // a dense cluster, and a few far out (short rows)
+    x[i] = V{{spread * rnd(), spread * rnd(), spread * rnd()}};
+    v[i] = V{{rnd(), rnd(), rnd()}};
+    kind[i] = i % 4 == 3 ? 1 : 0;  // every fourth a wall particle
+    wall_a[i] = kind[i] ? V{{0.5f * rnd(), 0.5f * rnd(), 0.5f * rnd()}} : V{};
+    m[i] = 1.0f + 0.2f * rnd();
+    rho[i] = 1000.0f + 30.0f * rnd();
+    mu[i] = 0.5f + 0.4f * rnd();
+    rho0[i] = i % 2 ? 1000.0f : 800.0f;
+    vol[i] = m[i] / rho[i];
+    alpha[i] = 1e-3f * (1.5f + rnd());
+    gsum[i] = V{{rnd(), rnd(), rnd()}};
+    gwall[i] = V{{rnd(), rnd(), rnd()}};
+    mv[i] = v[i] * m[i];
+  }
+  std::vector<std::uint64_t> offsets{0};
+  std::vector<std::uint32_t> rows, count(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::uint32_t j = 0; j < n; ++j)
+      if (j != i && norm2(V(x[i] - x[j])) <= h * h) rows.push_back(j);
+    count[i] = static_cast<std::uint32_t>(rows.size() - offsets.back());
+    offsets.push_back(rows.size());
+  }
+  std::vector<V> grads(rows.size());
+  for (auto& g : grads) g = V{{rnd(), rnd(), rnd()}};
+  const auto [shortest, longest] = std::minmax_element(count.begin(), count.end());
+  ASSERT_LT(*shortest, 3u);
+  ASSERT_GT(*longest, 20u);
+
+  std::vector<std::uint32_t> fluid;
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (!kind[i]) fluid.push_back(i);
+  const CubicSplineKernel<3, float> w(h);
+  for (const bool number : {false, true}) {
+    std::vector<float> kappa_alone(n), kappa_fused(n), mk_alone(n), mk_fused(n);
+    auto view = [&](std::vector<V>& f, std::vector<float>& kappa, std::vector<float>& mkv) {
+      ParticleView<3, float> pv;
+      pv.n = n;
+      pv.x = x.data();
+      pv.v = v.data();
+      pv.f = f.data();
+      pv.m = m.data();
+      pv.rho = rho.data();
+      pv.mu = mu.data();
+      pv.kind = kind.data();
+      pv.rho0 = rho0.data();
+      pv.vol = vol.data();
+      pv.df_alpha = alpha.data();
+      pv.df_kappa = kappa.data();
+      pv.df_gsum = gsum.data();
+      pv.df_gwall = gwall.data();
+      pv.df_mv = mv.data();
+      pv.df_mk = mkv.data();
+      pv.df_grad = grads.data();
+      pv.wall_a = wall_a.data();
+      pv.offsets = offsets.data();
+      pv.candidates = rows.data();
+      pv.within = rows.data();
+      pv.within_count = count.data();
+      return pv;
+    };
+    const DfsphSourceRule<float> rule{0.002f, false, false, 0.0f, acc.data(), 5};
+    const V gravity{{0.0f, -9.81f, 0.0f}};
+    auto forces_of = [&](const ParticleView<3, float>& pv) {
+      return DfsphNonPressurePass<3, float, CubicSplineKernel<3, float>>{pv,   w,      gravity, 1e-4f,
+                                                                         true, number, true};
+    };
+    const auto alone = view(f_alone, kappa_alone, mk_alone);
+    const auto fused = view(f_fused, kappa_fused, mk_fused);
+    run_pass(fluid, forces_of(alone));
+    const DfsphSourcePass<3, float, CubicSplineKernel<3, float>> source_alone{alone, w, rule, number};
+    const DfsphSourceForcesPass<3, float, CubicSplineKernel<3, float>> both{
+        DfsphSourcePass<3, float, CubicSplineKernel<3, float>>{fused, w, rule, number}, forces_of(fused)};
+    std::size_t differ = 0, wall_rows = 0;
+    for (const std::uint32_t i : fluid) {
+      const float e_alone = source_alone(i), e_fused = both(i);
+      differ += e_alone != e_fused || kappa_alone[i] != kappa_fused[i] || mk_alone[i] != mk_fused[i];
+      for (int a = 0; a < 3; ++a) differ += f_alone[i][a] != f_fused[i][a];
+      for (auto* it = alone.row_begin(i); it != alone.row_end(i); ++it) wall_rows += kind[*it];
+    }
+    EXPECT_EQ(differ, 0u) << (number ? "number" : "mass") << " density";
+    EXPECT_GT(wall_rows, 10u);
+    // The check sees a change: the forces without the walls' hydrostatic term differ.
+    auto plain = forces_of(fused);
+    plain.hydrostatic = false;
+    run_pass(fluid, plain);
+    std::size_t changed = 0;
+    for (const std::uint32_t i : fluid) changed += f_alone[i][0] != f_fused[i][0];
+    EXPECT_GT(changed, 0u);
+  }
 }
 
 // The conjugate-gradient density solve (models/dfsph_cg.hpp) on the deep column, where Jacobi is slow (the

@@ -78,6 +78,8 @@ struct DfsphStats {
   std::uint64_t max_iteration_hits = 0;  // solves stopped by max_iterations above their error bound
   std::uint64_t last_hit_step = 0;       // the step (1-based) of the last such solve
   double last_hit_error = 0;             // and the error [%] it reached
+  // Wall time of the step's stages [ms, summed]: ms_divergence includes the non-pressure forces (summed in the
+  // divergence solve's last pass), ms_nonpressure is their kick.
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
 };
 
@@ -102,26 +104,39 @@ CELLSPH_HD inline Real dfsph_weight(const ParticleView<Dim, Real>& pv, bool numb
   return pv.is_fluid(j) ? pv.m[i] : pv.m[j] / pv.rho0[j] * pv.rho0[i];
 }
 
+// A per-pair callback that does nothing: the rates below walk the row alone.
+struct DfsphNoPairWork {
+  template <class V>
+  CELLSPH_HD void operator()(std::uint32_t, const V&) const {}
+};
+
 // D rho_i / Dt = sum_j w_ij v_ij . grad W_ij (walls: their weight, their prescribed velocity), over i's
-// rows, with the step's gradients (df_grad, written by the density pass).
-template <int Dim, class Real>
-CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i, bool number) {
+// rows, with the step's gradients (df_grad, written by the density pass). also(j, grad W_ij) is called for
+// each pair on the way, in row order: another pass's sums ride along the same walk (DfsphSourceForcesPass).
+template <int Dim, class Real, class Also = DfsphNoPairWork>
+CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std::size_t i, bool number,
+                                          const Also& also = {}) {
   const Vec<Dim, Real> vi = pv.v[i];
   Real d = 0;
   const Vec<Dim, Real>* g = dfsph_row_grads(pv, i);
   for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) {
     const std::uint32_t j = *it;
     d += continuity_term(*g, dfsph_weight(pv, number, i, j), vi - pv.v[j]);
+    also(j, *g);
   }
   return d;
 }
 
 // The same rate regrouped for the mass density (the header): v_i . G_i - sum_j (w_j v_j) . grad W_ij.
-template <int Dim, class Real>
-CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>& pv, std::size_t i) {
+template <int Dim, class Real, class Also = DfsphNoPairWork>
+CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>& pv, std::size_t i,
+                                                   const Also& also = {}) {
   Real d = dot(pv.v[i], pv.df_gsum[i]);
   const Vec<Dim, Real>* g = dfsph_row_grads(pv, i);
-  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) d -= dot(pv.df_mv[*it], *g);
+  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) {
+    d -= dot(pv.df_mv[*it], *g);
+    also(*it, *g);
+  }
   return d;
 }
 
@@ -314,40 +329,77 @@ struct DfsphPressureKickPass {
 };
 
 // Step 4: the non-pressure forces, as the WCSPH model's (models/wcsph.hpp) without pressure and tension.
+// Its pair loop runs inside the divergence solve's last source pass (DfsphSourceForcesPass): the velocities
+// it reads are the solve's final ones, and the row is walked once for both.
 template <int Dim, class Real, class Kernel>
 struct DfsphNonPressurePass {
+  using V = Vec<Dim, Real>;
   ParticleView<Dim, Real> pv;
   Kernel w;
-  Vec<Dim, Real> gravity;
+  V gravity;
   Real eta2;  // the laminar operator's regulariser 0.01 h_s^2 (h_s = support / 2), as in models/wcsph.hpp
   bool no_slip;
   bool
       number;  // number density: a wall's volume is its weight rho0_i V_b over rho_i, i.e. V_b rho0_i / rho_i
   bool hydrostatic;  // walls' pressure p_i + rho_i (g - a_b) . (x_b - x_i): that part here, once a step
 
-  CELLSPH_HD void operator()(std::size_t i) const {
-    using V = Vec<Dim, Real>;
-    const V xi = pv.x[i], vi = pv.v[i];
-    const Real vol_i = pv.vol[i], mui = pv.mu[i], rhoi = pv.rho[i];
-    V f = gravity * pv.m[i];
-    const V* gr = dfsph_row_grads(pv, i);
-    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gr) {
-      const std::uint32_t j = *it;
-      const V xij = xi - pv.x[j];
-      const Real r2 = norm2(xij);
-      const V g = *gr;
-      if (pv.is_fluid(j)) {
-        f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, pv.vol[j], mui, pv.mu[j], eta2);
-        continue;
-      }
-      const Real wb = dfsph_weight(pv, number, i, j);
-      if (no_slip) f += morris_viscosity_force(V(vi - pv.v[j]), g, xij, r2, vol_i, wb / rhoi, mui, mui, eta2);
-      // The pressure force's wall term -m_i w_b (p_b / rho_i^2) grad W_ib for the part of p_b beyond p_i
-      // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i (g - a_b) . (x_b - x_i) = -rho_i (g - a_b) .
-      // x_ib, with a_b a moving wall's acceleration (the wall's frame sees g - a_b, as Adami's walls do).
-      if (hydrostatic) f += g * (pv.m[i] * wb * dot(pv.wall_gravity(gravity, j), xij) / rhoi);
+  // Particle i's side of the sum, and the sum itself.
+  struct Sum {
+    V xi, vi, f;
+    Real vol_i, mui, rhoi;
+  };
+  CELLSPH_HD Sum begin(std::size_t i) const {
+    return {pv.x[i], pv.v[i], gravity * pv.m[i], pv.vol[i], pv.mu[i], pv.rho[i]};
+  }
+  CELLSPH_HD void pair(Sum& s, std::size_t i, std::uint32_t j, const V& g) const {
+    const V xij = s.xi - pv.x[j];
+    const Real r2 = norm2(xij);
+    if (pv.is_fluid(j)) {
+      s.f += morris_viscosity_force(V(s.vi - pv.v[j]), g, xij, r2, s.vol_i, pv.vol[j], s.mui, pv.mu[j], eta2);
+      return;
     }
-    pv.f[i] = f;
+    const Real wb = dfsph_weight(pv, number, i, j);
+    if (no_slip)
+      s.f += morris_viscosity_force(V(s.vi - pv.v[j]), g, xij, r2, s.vol_i, wb / s.rhoi, s.mui, s.mui, eta2);
+    // The pressure force's wall term -m_i w_b (p_b / rho_i^2) grad W_ib for the part of p_b beyond p_i
+    // (the sweeps carry p_i's, mirrored): p_b - p_i = rho_i (g - a_b) . (x_b - x_i) = -rho_i (g - a_b) .
+    // x_ib, with a_b a moving wall's acceleration (the wall's frame sees g - a_b, as Adami's walls do).
+    if (hydrostatic) s.f += g * (pv.m[i] * wb * dot(pv.wall_gravity(gravity, j), xij) / s.rhoi);
+  }
+  CELLSPH_HD void finish(const Sum& s, std::size_t i) const { pv.f[i] = s.f; }
+
+  CELLSPH_HD void operator()(std::size_t i) const {
+    Sum s = begin(i);
+    const V* gr = dfsph_row_grads(pv, i);
+    for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++gr) pair(s, i, *it, *gr);
+    finish(s, i);
+  }
+};
+
+// A source pass (DfsphSourcePass) that also sums the non-pressure forces, in the same walk over the rows:
+// the divergence solve's passes that may be its last. Each sum is the one its own pass takes, in the same
+// order, so the bits are those of the two passes run one after the other.
+template <int Dim, class Real, class Kernel>
+struct DfsphSourceForcesPass {
+  using Forces = DfsphNonPressurePass<Dim, Real, Kernel>;
+  DfsphSourcePass<Dim, Real, Kernel> source;
+  Forces forces;
+
+  // The forces' term of a pair, called by the rate's walk over the row.
+  struct Along {
+    const Forces& forces;
+    typename Forces::Sum& sum;
+    std::size_t i;
+    CELLSPH_HD void operator()(std::uint32_t j, const Vec<Dim, Real>& g) const { forces.pair(sum, i, j, g); }
+  };
+
+  CELLSPH_HD Real operator()(std::size_t i) const {
+    auto sum = forces.begin(i);
+    const Along along{forces, sum, i};
+    const Real rate = source.number ? dfsph_density_rate(source.pv, i, true, along)
+                                    : dfsph_density_rate_factored(source.pv, i, along);
+    forces.finish(sum, i);
+    return source.rule.apply(source.pv, i, rate);
   }
 };
 
@@ -392,12 +444,15 @@ DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool war
 
 // One solve (density or divergence): warm start, then sweeps until the average error is at most eta
 // (relative) after at least min_it sweeps, or max_it sweeps were made. warm_k_set: the warm start's k are
-// written already (the density pass writes the mass density's divergence warm start).
+// written already (the density pass writes the mass density's divergence warm start). forces: the
+// non-pressure pass whose sums ride along every source pass that may be the solve's last (the velocities it
+// reads are then the solve's final ones; a pass that turns out not to be the last only wrote f early).
 template <int Dim, class Real, class Kernel, class Set>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
                              Real warm_scale, std::uint32_t min_neighbors, bool number, bool mirror,
-                             bool warm_k_set = false) {
+                             bool warm_k_set = false,
+                             const DfsphNonPressurePass<Dim, Real, Kernel>* forces = nullptr) {
   const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number, mirror};
   if (!warm_k_set)
     run_pass(set,
@@ -409,7 +464,11 @@ DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, 
   const double n = static_cast<double>(std::max<std::size_t>(set_size(set), 1));
   DfsphSolveResult r;
   for (;;) {
-    r.error = reduce_sum(set, source) / n;
+    const bool may_end = r.iterations >= min_it || r.iterations >= max_it;
+    r.error = (forces != nullptr && may_end
+                   ? reduce_sum(set, DfsphSourceForcesPass<Dim, Real, Kernel>{source, *forces})
+                   : reduce_sum(set, source)) /
+              n;
     if (!std::isfinite(r.error)) return r;
     if ((r.iterations >= min_it && r.error <= eta) || r.iterations >= max_it) return r;
     run_pass(set, kick);
@@ -487,16 +546,23 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
         st.last_hit_error = r.error * 100;
       }
     };
-    const DfsphSolveResult div = dfsph_solve(
-        pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
-        cfg.dfsph.warm_start, kDfsphDivergenceWarmScale<Real>, min_neighbors, number, mirror, !number);
+    // The divergence solve, which also sums the non-pressure forces (step 4) in its last source pass.
+    const DfsphNonPressurePass<Dim, Real, K> forces{
+        pv,
+        w,
+        cfg.gravity,
+        Real(0.01) * (h / 2) * (h / 2),
+        cfg.no_slip,
+        number,
+        cfg.dfsph.wall_pressure == DfsphWallPressure::Hydrostatic};
+    const DfsphSolveResult div =
+        dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
+                    cfg.dfsph.warm_start, kDfsphDivergenceWarmScale<Real>, min_neighbors, number, mirror,
+                    !number, &forces);
     check(div, eta_divergence, "divergence-free");
     st.ms_divergence += sw.ms();
     sw.reset();
 
-    run_pass(fluid, DfsphNonPressurePass<Dim, Real, K>{
-                        pv, w, cfg.gravity, Real(0.01) * (h / 2) * (h / 2), cfg.no_slip, number,
-                        cfg.dfsph.wall_pressure == DfsphWallPressure::Hydrostatic});
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
     st.ms_nonpressure += sw.ms();
     sw.reset();
