@@ -78,8 +78,8 @@ struct DfsphStats {
   std::uint64_t max_iteration_hits = 0;  // solves stopped by max_iterations above their error bound
   std::uint64_t last_hit_step = 0;       // the step (1-based) of the last such solve
   double last_hit_error = 0;             // and the error [%] it reached
-  // Wall time of the step's stages [ms, summed]: ms_divergence includes the non-pressure forces (summed in the
-  // divergence solve's last pass), ms_nonpressure is their kick.
+  // Wall time of the step's stages [ms, summed]: ms_divergence includes the non-pressure forces (summed in
+  // the divergence solve's last pass), ms_nonpressure is their kick.
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
 };
 
