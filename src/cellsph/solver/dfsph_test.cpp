@@ -414,6 +414,7 @@ TEST(Dfsph, DensityPassSumsLongRowsWithTheKernelsBits) {
   sim.step();
   const auto& q = sim.particles();
   const float h2 = cfg.support * cfg.support;
+  const double sigma = 8 / (3.14159265358979323846 * std::pow(double(cfg.support), 3));  // the 3D cubic's
   std::size_t longest = 0, mismatches = 0;
   double worst = 0;
   with_kernel<3, float>(cfg.density_kernel, cfg.support, [&](const auto w) {
@@ -427,7 +428,6 @@ TEST(Dfsph, DensityPassSumsLongRowsWithTheKernelsBits) {
         ++row;
         rho += q.m[j] * w.W2(r2);
         const double r = std::sqrt(double(r2)), qq = r / double(cfg.support);
-        const double sigma = 8 / (3.14159265358979323846 * std::pow(double(cfg.support), 3));
         ref +=
             double(q.m[j]) * sigma * (qq <= 0.5 ? 6 * (qq * qq * qq - qq * qq) + 1 : 2 * std::pow(1 - qq, 3));
       }

@@ -58,17 +58,21 @@ Result reduce_max_n(const std::uint32_t* idx, std::size_t n, Result init, const 
 // (cuda/cuda_driver.cuh) adds in the same order, so a device gives the same bits.
 inline constexpr std::size_t kSumBlock = 1024;
 
+// The sum of block b's entries (reduce_sum_n's unit), in order.
+template <class Pass>
+double reduce_sum_block(const std::uint32_t* idx, std::size_t n, std::size_t b, const Pass& pass) {
+  double s = 0;
+  const std::size_t end = std::min(n, (b + 1) * kSumBlock);
+  for (std::size_t k = b * kSumBlock; k < end; ++k)
+    s += static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
+  return s;
+}
+
 template <class Pass>
 double reduce_sum_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
   const std::size_t blocks = (n + kSumBlock - 1) / kSumBlock;
   std::vector<double> partial(blocks, 0.0);
-  parallel_for(blocks, [&](std::size_t b) {
-    double s = 0;
-    const std::size_t end = std::min(n, (b + 1) * kSumBlock);
-    for (std::size_t k = b * kSumBlock; k < end; ++k)
-      s += static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
-    partial[b] = s;
-  });
+  parallel_for(blocks, [&](std::size_t b) { partial[b] = reduce_sum_block(idx, n, b, pass); });
   double s = 0;
   for (const double q : partial) s += q;
   return s;
@@ -107,6 +111,109 @@ Result reduce_max(const IndexSet& set, Result init, const Pass& pass) {
 template <class Pred>
 std::int64_t first_where(const IndexSet& set, const Pred& pred) {
   return first_where_n(set.data(), set.size(), pred);
+}
+
+// An index set split between the threads by weight instead of by count: part t, entries [cuts[t],
+// cuts[t + 1]), runs on thread t in every pass (as the static split keeps a thread on the same particles
+// from pass to pass). The solver weighs a particle by its row length, so that each thread walks about as
+// many pairs: split by count, the first thread of the DFSPH dam break walked 4% more pairs than the second
+// (a dynamic schedule was slower, docs/benchmarks.md). reduce_sum splits the same way in whole blocks
+// (block_cuts), so a sum adds the same blocks in the same order: the split moves no result, only time. A
+// team of another size than the split's runs the parts round robin.
+struct BalancedIndexSet {
+  const IndexSet* set = nullptr;
+  std::vector<std::size_t> cuts;        // run_pass: parts + 1 entries, 0, ..., set->size()
+  std::vector<std::size_t> block_cuts;  // reduce_sum: the same in reduce_sum's blocks, 0, ..., blocks
+};
+
+// The split of `set` into `parts` by weight(i) for each index i (give a particle with an empty row some
+// weight too: its own loads and stores take time): each inner cut is the entry where its share of the
+// total weight is reached, and for reduce_sum the block boundary nearest to it (or equal numbers of
+// blocks, where that is better balanced).
+template <class Weight>
+void balance(const IndexSet& set, std::size_t parts, const Weight& weight, BalancedIndexSet& out) {
+  const std::size_t n = set.size(), blocks = (n + kSumBlock - 1) / kSumBlock;
+  parts = std::max<std::size_t>(parts, 1);
+  std::vector<std::uint64_t> before(blocks + 1, 0);  // the weight of the blocks ahead of each boundary
+  parallel_for(blocks, [&](std::size_t b) {
+    std::uint64_t w = 0;
+    for (std::size_t k = b * kSumBlock; k < std::min(n, (b + 1) * kSumBlock); ++k) w += weight(set[k]);
+    before[b + 1] = w;
+  });
+  for (std::size_t b = 0; b < blocks; ++b) before[b + 1] += before[b];
+  out.set = &set;
+  out.cuts.assign(parts + 1, n);
+  out.block_cuts.assign(parts + 1, blocks);
+  out.cuts[0] = out.block_cuts[0] = 0;
+  for (std::size_t t = 1; t < parts; ++t) {
+    const double share = double(before[blocks]) * double(t) / double(parts);
+    // The first boundary at or past the share, and the entry within the block before it.
+    std::size_t b =
+        static_cast<std::size_t>(std::lower_bound(before.begin(), before.end(), share) - before.begin());
+    b = std::min(b, blocks);
+    std::size_t k = b > 0 ? (b - 1) * kSumBlock : 0;
+    for (std::uint64_t w = b > 0 ? before[b - 1] : 0; k < std::min(n, b * kSumBlock) && double(w) < share;
+         ++k)
+      w += weight(set[k]);
+    out.cuts[t] = std::max(k, out.cuts[t - 1]);
+    if (b > 0 && share - double(before[b - 1]) < double(before[b]) - share) --b;
+    out.block_cuts[t] = std::max(b, out.block_cuts[t - 1]);
+  }
+  // With few blocks a part, rounding to blocks can leave a part heavier than the static split's (blocks in
+  // equal numbers, reduce_sum_n's): keep whichever has the lighter heaviest part.
+  std::vector<std::size_t> by_count(parts + 1);
+  for (std::size_t t = 0; t <= parts; ++t) by_count[t] = blocks * t / parts;
+  auto heaviest = [&](const std::vector<std::size_t>& c) {
+    std::uint64_t m = 0;
+    for (std::size_t t = 0; t < parts; ++t) m = std::max(m, before[c[t + 1]] - before[c[t]]);
+    return m;
+  };
+  if (heaviest(by_count) < heaviest(out.block_cuts)) out.block_cuts = by_count;
+}
+
+// f(part) for every part of a balanced set, part t on thread t where the team has the split's size.
+template <class F>
+void for_each_part(const BalancedIndexSet& set, F&& f) {
+  const auto parts = static_cast<std::int64_t>(set.cuts.size() - 1);
+#pragma omp parallel
+  {
+    const auto nt = static_cast<std::int64_t>(omp_get_num_threads());
+    for (auto t = static_cast<std::int64_t>(omp_get_thread_num()); t < parts; t += nt)
+      f(static_cast<std::size_t>(t));
+  }
+}
+
+template <class Pass>
+void run_pass(const BalancedIndexSet& set, const Pass& pass) {
+  const std::uint32_t* idx = set.set->data();
+  for_each_part(set, [&](std::size_t t) {
+    for (std::size_t k = set.cuts[t]; k < set.cuts[t + 1]; ++k) pass(static_cast<std::size_t>(idx[k]));
+  });
+}
+
+// reduce_sum_n's blocks and order, each part summing its blocks (block_cuts).
+template <class Pass>
+double reduce_sum(const BalancedIndexSet& set, const Pass& pass) {
+  const std::uint32_t* idx = set.set->data();
+  const std::size_t n = set.set->size();
+  std::vector<double> partial((n + kSumBlock - 1) / kSumBlock, 0.0);
+  for_each_part(set, [&](std::size_t t) {
+    for (std::size_t b = set.block_cuts[t]; b < set.block_cuts[t + 1]; ++b)
+      partial[b] = reduce_sum_block(idx, n, b, pass);
+  });
+  double s = 0;
+  for (const double q : partial) s += q;
+  return s;
+}
+
+inline std::size_t set_size(const BalancedIndexSet& set) {
+  return set.set->size();
+}
+
+// A maximum does not depend on the split: the plain set's.
+template <class Result, class Pass>
+Result reduce_max(const BalancedIndexSet& set, Result init, const Pass& pass) {
+  return reduce_max(*set.set, init, pass);
 }
 
 }  // namespace cellsph

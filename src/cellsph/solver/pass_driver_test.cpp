@@ -141,6 +141,97 @@ TEST(PassDriver, ReduceSumAddsInFixedBlocksWhateverTheThreadCount) {
   EXPECT_EQ(reduce_sum(IndexSet{}, pass), 0.0);
 }
 
+// A set split by weight: every index once, the cuts on block boundaries and near each part's share of
+// the weight, sums with the plain set's bits, for splits into as many parts as threads and into others.
+TEST(PassDriver, BalancedSetSplitsByWeightAndKeepsEverySum) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> value(200000);
+  for (double& v : value) v = u(rng) * std::pow(10.0, static_cast<int>(rng() % 9) - 4);
+  const IndexSet set = random_set(rng, 200000);  // about 133 000 entries, 131 blocks
+  // Heavy rows in the first quarter of the set: a split by count would give the first part most weight.
+  // Weights of 1-60 in the first quarter, 1-10 after it: half the weight lies in the first fifth.
+  std::vector<std::uint64_t> weight(200000);
+  for (std::uint32_t i = 0; i < 200000; ++i) weight[i] = 1 + (i < 50000 ? rng() % 60 : rng() % 10);
+  auto pass = [&](std::size_t i) { return value[i]; };
+  for (const int threads : {1, 2, 3}) {
+    ScopedThreads st(threads);
+    const double want = reduce_sum(set, pass);
+    for (const std::size_t parts : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{4}}) {
+      BalancedIndexSet split;
+      balance(
+          set, parts, [&](std::uint32_t i) { return weight[i]; }, split);
+      ASSERT_EQ(split.cuts.size(), parts + 1);
+      ASSERT_EQ(split.block_cuts.size(), parts + 1);
+      EXPECT_EQ(split.cuts.front(), 0u);
+      EXPECT_EQ(split.cuts.back(), set.size());
+      EXPECT_EQ(split.block_cuts.front(), 0u);
+      EXPECT_EQ(split.block_cuts.back(), (set.size() + kSumBlock - 1) / kSumBlock);
+      std::uint64_t total = 0, heaviest = 0;  // the set's weight, and its heaviest entry's and block's
+      std::uint64_t heaviest_entry = 0;
+      for (std::size_t k0 = 0; k0 < set.size(); k0 += kSumBlock) {
+        std::uint64_t w = 0;
+        for (std::size_t k = k0; k < std::min(set.size(), k0 + kSumBlock); ++k) {
+          w += weight[set[k]];
+          heaviest_entry = std::max(heaviest_entry, weight[set[k]]);
+        }
+        total += w;
+        heaviest = std::max(heaviest, w);
+      }
+      for (std::size_t t = 1; t < parts; ++t) {
+        EXPECT_GE(split.cuts[t], split.cuts[t - 1]);
+        EXPECT_GE(split.block_cuts[t], split.block_cuts[t - 1]);
+        std::uint64_t before = 0, before_block = 0;
+        for (std::size_t k = 0; k < split.cuts[t]; ++k) before += weight[set[k]];
+        for (std::size_t k = 0; k < std::min(set.size(), split.block_cuts[t] * kSumBlock); ++k)
+          before_block += weight[set[k]];
+        // The entry cut within one entry's weight of its share, the block cut within half a block's.
+        const double share = double(total) * double(t) / double(parts);
+        EXPECT_NEAR(double(before), share, double(heaviest_entry)) << parts << " parts, cut " << t;
+        if (parts <= 4) {  // 33 or more blocks a part: the block cuts are the weighted ones
+          EXPECT_NEAR(double(before_block), share, 0.5 * double(heaviest)) << parts << " parts, cut " << t;
+        }
+      }
+      if (parts == 2) {
+        EXPECT_LT(split.cuts[1], set.size() / 4) << "the heavy first quarter moves the cut down";
+      }
+      std::vector<int> hits(200000, 0);
+      run_pass(split, [&](std::size_t i) { ++hits[i]; });
+      for (const std::uint32_t i : set) EXPECT_EQ(hits[i], 1) << i;
+      EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), static_cast<std::ptrdiff_t>(set.size()));
+      EXPECT_EQ(reduce_sum(split, pass), want) << threads << " threads, " << parts << " parts";
+      EXPECT_EQ(set_size(split), set.size());
+      double mx = 0;
+      for (const std::uint32_t i : set) mx = std::max(mx, value[i]);
+      EXPECT_EQ(reduce_max(split, MaxPair{}, [&](std::size_t i) { return MaxPair{value[i], 0}; }).a, mx);
+    }
+  }
+  // Sets of one partial block and a little more, split in more parts than blocks: every entry once in a
+  // sum too (a pass may write as it sums).
+  for (const std::uint32_t n : {700u, 1500u}) {
+    const IndexSet small = random_set(rng, n);
+    for (const int threads : {1, 2, 3}) {
+      ScopedThreads st(threads);
+      for (const std::size_t parts : {std::size_t{2}, std::size_t{3}}) {
+        BalancedIndexSet split;
+        balance(
+            small, parts, [&](std::uint32_t i) { return weight[i]; }, split);
+        std::vector<int> hits(n, 0);
+        const double visits = reduce_sum(split, [&](std::size_t i) { return double(++hits[i]); });
+        EXPECT_EQ(visits, double(small.size()))
+            << n << " entries, " << threads << " threads, " << parts << " parts";
+        for (const std::uint32_t i : small) EXPECT_EQ(hits[i], 1) << i;
+      }
+    }
+  }
+  BalancedIndexSet empty_split;
+  const IndexSet empty;
+  balance(
+      empty, 2, [](std::uint32_t) { return std::uint64_t{1}; }, empty_split);
+  EXPECT_EQ(reduce_sum(empty_split, pass), 0.0);
+  run_pass(empty_split, [](std::size_t) { ADD_FAILURE() << "a pass over an empty set"; });
+}
+
 // Rows searched at h itself are used as they are: only their lengths are written.
 TEST(Passes, RowLengthPassCountsRowsAsTheyAre) {
   Line l;

@@ -733,7 +733,12 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
     cg_active_.resize(n);
   }
   if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
-  const Real dt = dfsph_step(cfg_, view(), fluid_, n, df_diameter_, dfsph_stats_, steps_ + 1);
+  // The threads split the fluid by pairs, not by particles (pass_driver.hpp): the same bits either way.
+  balance(
+      fluid_, static_cast<std::size_t>(max_threads()),
+      [&](std::uint32_t i) { return std::uint64_t{within_count_[i]} + kBalanceParticleWeight; },
+      fluid_split_);
+  const Real dt = dfsph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1);
   timings_.forces += sw.ms();
   sw.reset();
   inflow_hold(dt);

@@ -332,6 +332,11 @@ class Simulation {
   std::vector<std::uint8_t> cg_active_;
   Real df_diameter_ = 0;
   DfsphStats dfsph_stats_;
+  // DFSPH's passes run over the fluid split between the threads by row length (pass_driver.hpp), rebuilt
+  // each step. A particle's own loads and stores weigh about as much as four pairs' (a pair reads 16
+  // bytes in order and gathers one or three values; a particle some 60 bytes).
+  BalancedIndexSet fluid_split_;
+  static constexpr std::uint64_t kBalanceParticleWeight = 4;
 
   // Emitters and sinks (config inflow, emitters.hpp): each emitter's frame and layer lattice (from the
   // config) and its plane as the passes read it, its `advance` and the next free id (integrator state,
