@@ -17,3 +17,21 @@
 #else
 #define CELLSPH_INLINE inline
 #endif
+
+// Before a pair loop that sums in row order (the sweeps' rates and kicks): keeps the host compiler from
+// vectorizing it. GCC 12 otherwise takes two pairs an iteration in an in-order (strict IEEE) reduction,
+// with about ten shuffles a pair that cost more than they save: one pair an iteration is 10-15% faster
+// (docs/benchmarks.md, DFSPH). The sums and their order, hence the bits, are the same either way. The loop
+// must be in OpenMP's canonical form (an integer index). Empty in device code.
+#if defined(__CUDA_ARCH__)
+#define CELLSPH_SCALAR_LOOP
+#elif defined(__clang__)
+#define CELLSPH_SCALAR_LOOP _Pragma("clang loop vectorize(disable) interleave(disable)")
+#elif defined(__GNUC__) && __GNUC__ >= 14
+#define CELLSPH_SCALAR_LOOP _Pragma("GCC novector")
+#elif defined(__GNUC__) && defined(_OPENMP)
+// No iteration runs beside another (safelen 1), one lane (simdlen 1): GCC 12 then leaves the loop scalar.
+#define CELLSPH_SCALAR_LOOP _Pragma("omp simd safelen(1) simdlen(1)")
+#else
+#define CELLSPH_SCALAR_LOOP
+#endif

@@ -133,9 +133,12 @@ CELLSPH_HD inline Real dfsph_density_rate_factored(const ParticleView<Dim, Real>
                                                    const Also& also = {}) {
   Real d = dot(pv.v[i], pv.df_gsum[i]);
   const Vec<Dim, Real>* g = dfsph_row_grads(pv, i);
-  for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) {
-    d -= dot(pv.df_mv[*it], *g);
-    also(*it, *g);
+  const std::uint32_t* row = pv.row_begin(i);
+  const std::ptrdiff_t n = pv.row_end(i) - row;
+  CELLSPH_SCALAR_LOOP
+  for (std::ptrdiff_t k = 0; k < n; ++k) {
+    d -= dot(pv.df_mv[row[k]], g[k]);
+    also(row[k], g[k]);
   }
   return d;
 }
@@ -307,7 +310,10 @@ struct DfsphPressureKickPass {
     if (!number) {          // the regrouped sum (header): -m_i (k_i G_i + sum_j (m_j k_j) grad W_ij)
       V s = (mirror ? V(pv.df_gsum[i] + pv.df_gwall[i]) : pv.df_gsum[i]) * ki;
       const V* g = dfsph_row_grads(pv, i);
-      for (const auto* it = pv.row_begin(i); it != pv.row_end(i); ++it, ++g) s += *g * pv.df_mk[*it];
+      const std::uint32_t* row = pv.row_begin(i);
+      const std::ptrdiff_t n = pv.row_end(i) - row;
+      CELLSPH_SCALAR_LOOP
+      for (std::ptrdiff_t k = 0; k < n; ++k) s += g[k] * pv.df_mk[row[k]];
       pv.v[i] -= s * dt;
       pv.df_mv[i] = pv.v[i] * mi;
       return;
