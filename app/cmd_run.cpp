@@ -116,14 +116,19 @@ void reject_old_checkpoint(const std::filesystem::path& file) {
 }
 
 // DFSPH's part of the progress line: sweeps of the last step (density / divergence), its average
-// density error and step.
+// density error and step; IISPH's: its iterations, error and step.
 template <int Dim, class Real>
 std::string dfsph_progress(const Simulation<Dim, Real>& sim) {
-  if (sim.config().model != Model::Dfsph) return "";
+  const Model model = sim.config().model;
+  if (!implicit_pressure(model)) return "";
   const auto& st = sim.dfsph_stats();
   char buf[160];
-  std::snprintf(buf, sizeof buf, "  dfsph %d+%d sweeps, err %.3f%%, dt %.3g ms", st.last_density_iterations,
-                st.last_divergence_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
+  if (model == Model::Iisph)
+    std::snprintf(buf, sizeof buf, "  iisph %d iterations, err %.3f%%, dt %.3g ms",
+                  st.last_density_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
+  else
+    std::snprintf(buf, sizeof buf, "  dfsph %d+%d sweeps, err %.3f%%, dt %.3g ms", st.last_density_iterations,
+                  st.last_divergence_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
   return buf;
 }
 
@@ -429,6 +434,27 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
         steps ? (double(sim.time()) - t_at_start) / double(steps) : 0.0,
         static_cast<unsigned long long>(loop.next_frame), out.string().c_str(), pct(tm.neighbors).c_str(),
         pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
+    if (cfg.model == Model::Iisph) {
+      const auto& st = sim.dfsph_stats();
+      const double n = double(std::max<std::uint64_t>(st.steps, 1));
+      const double its = double(st.density_iterations);
+      std::fprintf(
+          stderr,
+          "         iisph: %.2f iterations/step, density error last %.3g%% max %.3g%% (bound %.3g%%), "
+          "%llu solves stopped at max_iterations%s\n",
+          its / n, st.last_density_error, st.max_density_error, double(cfg.dfsph.max_density_error),
+          static_cast<unsigned long long>(st.max_iteration_hits),
+          st.max_iteration_hits ? (" (last: step " + std::to_string(st.last_hit_step) + ", error " +
+                                   fmt("%.3g", st.last_hit_error) + "%)")
+                                      .c_str()
+                                : "");
+      std::fprintf(
+          stderr,
+          "         iisph ms/step: search %.3g, density+alpha %.3g, non-pressure forces %.3g, pressure "
+          "solve %.3g, drift %.3g (%.3g ms an iteration)\n",
+          tm.neighbors / n, st.ms_factor / n, st.ms_nonpressure / n, st.ms_density / n, st.ms_drift / n,
+          its > 0 ? st.ms_density / its : 0.0);
+    }
     if (cfg.model == Model::Dfsph) {
       const auto& st = sim.dfsph_stats();
       const double n = double(std::max<std::uint64_t>(st.steps, 1));

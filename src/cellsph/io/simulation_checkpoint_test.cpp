@@ -121,34 +121,45 @@ TEST(SimulationCheckpoint, ResumeIsBitIdenticalWcsphContinuityFourtakas3DFloat) 
   resume_is_bit_identical<3, float>(Model::Wcsph, true);
 }
 
-// DFSPH: a block of water with jittered velocities in a closed box of Akinci walls, reordered every 5
-// steps. The divergence solve's warm start (the solver state dfsph_kappa_v) is not a particle field: the
-// checkpoint must carry it. The test shows it does matter: a resume that drops it (restore without the
-// solver state, as the format-1 checkpoints did) differs from the uninterrupted run.
+// The implicit models' resume cases: a block of water (spacing 0.02 m, 8 x 8 in 2D, 4^3 in 3D) with
+// jittered velocities in a closed box of Akinci walls twice its height, water's viscosity, reordered every
+// 5 steps.
 template <int Dim, class Real>
-void dfsph_resume_is_bit_identical() {
+SolverConfig<Dim, Real> implicit_box_config(Model model) {
+  SolverConfig<Dim, Real> cfg = test::dfsph_water<Dim, Real>(Real(0.02), Real(0.001), Real(2e-3));
+  cfg.model = model;
+  cfg.reorder_every = 5;
+  return cfg;
+}
+template <int Dim, class Real>
+Particles<Dim, Real> implicit_box() {
   using V = Vec<Dim, Real>;
-  ScopedThreads one(1);
-  test::TempDir dir("sim_ckpt_dfsph");
   const Real s = Real(0.02);
   const int nx = Dim == 2 ? 8 : 4;
-  SolverConfig<Dim, Real> cfg = test::dfsph_water<Dim, Real>(s, Real(0.001), Real(2e-3));
-  cfg.reorder_every = 5;
   V lo{}, hi{}, box{};
   for (int a = 0; a < Dim; ++a) {
     hi[a] = s * Real(nx);
     box[a] = a == Dim - 1 ? 2 * hi[a] : hi[a];
   }
-  auto make = [&] {
-    Particles<Dim, Real> p;
-    add_block<Dim, Real>(p, lo, hi, s, 0);
-    std::mt19937 gen(5);
-    std::uniform_real_distribution<double> u(-0.3, 0.3);
-    for (auto& v : p.v)
-      for (int a = 0; a < Dim; ++a) v[a] = Real(u(gen));
-    add_box_walls<Dim, Real>(p, lo, box, s, 2, false, 0, Real(1000 * std::pow(double(s), Dim)));
-    return p;
-  };
+  Particles<Dim, Real> p;
+  add_block<Dim, Real>(p, lo, hi, s, 0);
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (auto& v : p.v)
+    for (int a = 0; a < Dim; ++a) v[a] = Real(u(gen));
+  add_box_walls<Dim, Real>(p, lo, box, s, 2, false, 0, Real(1000 * std::pow(double(s), Dim)));
+  return p;
+}
+
+// DFSPH: the box above. The divergence solve's warm start (the solver state dfsph_kappa_v) is not a particle
+// field: the checkpoint must carry it. The test shows it does matter: a resume that drops it (restore without
+// the solver state, as the format-1 checkpoints did) differs from the uninterrupted run.
+template <int Dim, class Real>
+void dfsph_resume_is_bit_identical() {
+  ScopedThreads one(1);
+  test::TempDir dir("sim_ckpt_dfsph");
+  const auto cfg = implicit_box_config<Dim, Real>(Model::Dfsph);
+  const auto make = [] { return implicit_box<Dim, Real>(); };
   Simulation<Dim, Real> full(cfg, make());
   for (int k = 0; k < 12; ++k) full.step();
   write_simulation_checkpoint(full, "", dir / "c.ckpt");
@@ -181,6 +192,33 @@ TEST(SimulationCheckpoint, ResumeIsBitIdenticalDfsph2DDouble) {
 }
 TEST(SimulationCheckpoint, ResumeIsBitIdenticalDfsph3DFloat) {
   dfsph_resume_is_bit_identical<3, float>();
+}
+
+// IISPH: the same box; its warm start is the pressure field, which the checkpoint carries with the
+// particles. 12 steps, checkpoint, 12 more against the uninterrupted run.
+template <int Dim, class Real>
+void iisph_resume_is_bit_identical() {
+  ScopedThreads one(1);
+  test::TempDir dir("sim_ckpt_iisph");
+  const auto cfg = implicit_box_config<Dim, Real>(Model::Iisph);
+  const auto make = [] { return implicit_box<Dim, Real>(); };
+  Simulation<Dim, Real> full(cfg, make());
+  for (int k = 0; k < 12; ++k) full.step();
+  write_simulation_checkpoint(full, "", dir / "c.ckpt");
+  for (int k = 0; k < 12; ++k) full.step();
+  Simulation<Dim, Real> resumed(cfg, make());
+  read_simulation_checkpoint(dir / "c.ckpt", resumed);
+  for (int k = 0; k < 12; ++k) resumed.step();
+  EXPECT_TRUE(same_fields(full.particles(), resumed.particles()));
+  EXPECT_EQ(full.time(), resumed.time());
+  EXPECT_EQ(full.dfsph_stats().last_density_iterations, resumed.dfsph_stats().last_density_iterations);
+}
+
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalIisph2DDouble) {
+  iisph_resume_is_bit_identical<2, double>();
+}
+TEST(SimulationCheckpoint, ResumeIsBitIdenticalIisph3DFloat) {
+  iisph_resume_is_bit_identical<3, float>();
 }
 
 std::string load_error(const std::filesystem::path& path, Simulation<2, double>& sim) {

@@ -255,7 +255,7 @@ void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& c
                     ray_length_in<Dim>(blocks[b], x, up);
     const auto ph = static_cast<std::size_t>(p.phase[i]);
     const Real rho0 = cfg.phases[ph].rest_density;
-    const bool incompressible = cfg.model == Model::Dfsph;
+    const bool incompressible = implicit_pressure(cfg.model);
     const double rho =
         incompressible ? double(rho0) : double(cfg.eos.density(static_cast<Real>(pressure), rho0));
     p.m[i] = mass_given[ph] ? static_cast<Real>(double(cfg.phases[ph].mass) * rho / double(rho0))
@@ -476,6 +476,32 @@ void read_artificial_viscosity(JsonReader& sr, SolverConfig<Dim, Real>& cfg) {
   ar.finish();
 }
 
+// The wall pressure of the DFSPH and IISPH pressure forces (/solver/dfsph or /solver/iisph wall_pressure).
+inline DfsphWallPressure read_wall_pressure(JsonReader& r) {
+  const std::string w = r.choice("wall_pressure", "zero", {"zero", "mirrored", "hydrostatic"});
+  return w == "zero"       ? DfsphWallPressure::Zero
+         : w == "mirrored" ? DfsphWallPressure::Mirrored
+                           : DfsphWallPressure::Hydrostatic;
+}
+
+// /solver/iisph: IISPH's settings, kept in SolverConfig::dfsph (config.hpp).
+template <class D>
+void read_iisph(JsonReader& ir, D& d) {
+  using Real = decltype(d.relaxation);
+  d.max_density_error =
+      static_cast<Real>(ir.number("max_density_error", double(d.max_density_error), 1e-9, 100));
+  d.min_iterations = static_cast<int>(ir.integer("min_iterations", d.min_iterations, 0, 100000));
+  d.max_iterations = static_cast<int>(ir.integer("max_iterations", d.max_iterations, 1, 100000));
+  d.warm_start = ir.boolean("warm_start", d.warm_start);
+  d.warm_start_scale = static_cast<Real>(ir.number("warm_start_scale", double(d.warm_start_scale), 1e-9, 1));
+  d.relaxation = static_cast<Real>(ir.number("relaxation", double(d.relaxation), 1e-9, 1));
+  d.wall_pressure = read_wall_pressure(ir);
+  if (d.min_iterations > d.max_iterations)
+    ir.fail("min_iterations", "value " + std::to_string(d.min_iterations) + " exceeds max_iterations " +
+                                  std::to_string(d.max_iterations));
+  ir.finish();
+}
+
 template <int Dim, class Real>
 void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   cfg.support = static_cast<Real>(2 * spacing);
@@ -484,8 +510,8 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     return;
   }
   auto sr = r.child("solver");
-  cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph", "dfsph"}));
-  if (cfg.model == Model::Dfsph) {
+  cfg.model = *parse_model(sr.choice("model", "wcsph", {"paper", "wcsph", "dfsph", "iisph"}));
+  if (implicit_pressure(cfg.model)) {
     cfg.time.courant = Real(0.4);  // on the particle diameter (models/dfsph.hpp)
     // A CFL step moves the fastest particle 0.4 d, three times the 0.45 of the default skin after which
     // the lists are rebuilt, so skinned lists seldom last a step; without the skin the rows, the stored
@@ -526,6 +552,11 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   cfg.tension = *parse_tension_model(sr.choice("tension", "paper", {"paper", "csf", "akinci"}));
   cfg.restitution = static_cast<Real>(sr.number("restitution", double(cfg.restitution), 0, 1));
   cfg.friction = static_cast<Real>(sr.number("friction", double(cfg.friction), 0, 1));
+  if (sr.has("iisph")) {
+    auto ir = sr.child("iisph");
+    if (cfg.model != Model::Iisph) ir.fail_here("is read only with /solver/model = \"iisph\"");
+    read_iisph(ir, cfg.dfsph);
+  }
   if (sr.has("dfsph")) {
     auto dr = sr.child("dfsph");
     if (cfg.model != Model::Dfsph) dr.fail_here("is read only with /solver/model = \"dfsph\"");
@@ -542,10 +573,7 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     d.density_solver = dr.choice("density_solver", "jacobi", {"jacobi", "cg"}) == "cg"
                            ? DfsphDensitySolver::ConjugateGradient
                            : DfsphDensitySolver::Jacobi;
-    const std::string wall_pressure = dr.choice("wall_pressure", "zero", {"zero", "mirrored", "hydrostatic"});
-    d.wall_pressure = wall_pressure == "zero"       ? DfsphWallPressure::Zero
-                      : wall_pressure == "mirrored" ? DfsphWallPressure::Mirrored
-                                                    : DfsphWallPressure::Hydrostatic;
+    d.wall_pressure = read_wall_pressure(dr);
     if (d.min_iterations > d.max_iterations)
       dr.fail("min_iterations", "value " + std::to_string(d.min_iterations) + " exceeds max_iterations " +
                                     std::to_string(d.max_iterations));
@@ -1461,7 +1489,8 @@ void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
   };
   const nlohmann::json* solver = at(j, "solver");
   const nlohmann::json* model = solver ? at(*solver, "model") : nullptr;
-  if (!model || *model != "dfsph") return;
+  if (!model || (*model != "dfsph" && *model != "iisph")) return;
+  const std::string name = *model == "dfsph" ? "DFSPH" : "IISPH";
   std::string what, sets;
   auto add = [&](const std::string& w, const std::string& set) {
     what += what.empty() ? "" : "; ";
@@ -1472,7 +1501,8 @@ void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
   const nlohmann::json* boundary = at(j, "boundary");
   if (const nlohmann::json* wm = boundary ? at(*boundary, "model") : nullptr;
       wm && wm->is_string() && *wm != "akinci")
-    add("/boundary/model is " + json_value_text(*wm) + " (DFSPH holds Akinci 2012 boundary particles only)",
+    add("/boundary/model is " + json_value_text(*wm) + " (" + name +
+            " holds Akinci 2012 boundary particles only)",
         "--set /boundary/model=akinci");
   const nlohmann::json* av = at(*solver, "artificial_viscosity");
   if (const nlohmann::json* alpha = av ? at(*av, "alpha") : nullptr;
@@ -1484,8 +1514,8 @@ void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
     add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model)",
         "--set /solver/density=mass");
   if (what.empty()) return;
-  throw InputError(source + ": /solver/model = \"dfsph\" does not fit this scene's settings: " + what +
-                   ". Add: " + sets);
+  throw InputError(source + ": /solver/model = " + json_value_text(*model) +
+                   " does not fit this scene's settings: " + what + ". Add: " + sets);
 }
 
 }  // namespace

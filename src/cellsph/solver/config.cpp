@@ -88,16 +88,23 @@ void SolverConfig<Dim, Real>::validate() const {
   if (artificial_viscosity.alpha > 0 && model != Model::Wcsph)
     bad("artificial_viscosity.alpha", artificial_viscosity.alpha,
         "artificial viscosity is part of the WCSPH model (model = wcsph)");
-  if (model == Model::Dfsph) {
-    positive("dfsph.max_density_error", dfsph.max_density_error);
-    positive("dfsph.max_divergence_error", dfsph.max_divergence_error);
-    if (dfsph.min_iterations < 0) bad("dfsph.min_iterations", dfsph.min_iterations, "must be >= 0");
-    if (dfsph.max_iterations < 1) bad("dfsph.max_iterations", dfsph.max_iterations, "must be >= 1");
+  if (implicit_pressure(model)) {
+    // IISPH's settings are SolverConfig::dfsph too; its messages name them as the scene does (iisph.*).
+    const std::string sec = model == Model::Iisph ? "iisph." : "dfsph.";
+    const std::string name = model == Model::Iisph ? "IISPH" : "DFSPH";
+    positive(sec + "max_density_error", dfsph.max_density_error);
+    if (model == Model::Dfsph) positive("dfsph.max_divergence_error", dfsph.max_divergence_error);
+    if (dfsph.min_iterations < 0) bad(sec + "min_iterations", dfsph.min_iterations, "must be >= 0");
+    if (dfsph.max_iterations < 1) bad(sec + "max_iterations", dfsph.max_iterations, "must be >= 1");
     if (dfsph.min_iterations > dfsph.max_iterations)
-      bad("dfsph.min_iterations", dfsph.min_iterations,
-          ("must not exceed dfsph.max_iterations = " + std::to_string(dfsph.max_iterations)).c_str());
+      bad(sec + "min_iterations", dfsph.min_iterations,
+          ("must not exceed " + sec + "max_iterations = " + std::to_string(dfsph.max_iterations)).c_str());
     if (!(dfsph.warm_start_scale > 0 && dfsph.warm_start_scale <= 1))
-      bad("dfsph.warm_start_scale", dfsph.warm_start_scale, "must be in (0, 1]");
+      bad(sec + "warm_start_scale", dfsph.warm_start_scale, "must be in (0, 1]");
+    if (model == Model::Iisph && !(dfsph.relaxation > 0 && dfsph.relaxation <= 1))
+      bad("iisph.relaxation", dfsph.relaxation, "must be in (0, 1]");
+    if (model == Model::Iisph && dfsph.density_solver != DfsphDensitySolver::Jacobi)
+      bad("dfsph.density_solver", "cg", "IISPH's solve is its relaxed Jacobi iteration");
     // Several phases: the number density's system is not symmetric in k (its pair force weighs m_i^2 k_i
     // and m_j^2 k_j), which CG needs.
     if (dfsph.density_solver == DfsphDensitySolver::ConjugateGradient &&
@@ -110,18 +117,20 @@ void SolverConfig<Dim, Real>::validate() const {
     // sweep changes (docs/physics.md, "DFSPH").
     if (wall_model != WallModel::Akinci)
       bad("boundary.model", wall_model_name(wall_model),
-          "the DFSPH model supports Akinci 2012 boundary particles only (boundary.model = akinci)");
+          ("the " + name + " model supports Akinci 2012 boundary particles only (boundary.model = akinci)")
+              .c_str());
     for (std::size_t k = 0; k < phases.size(); ++k)
       if (phases[k].sigma > 0)
         bad("phases[" + std::to_string(k) + "].sigma", phases[k].sigma,
-            "the DFSPH model has no surface tension yet (sigma must be 0)");
+            ("the " + name + " model has no surface tension yet (sigma must be 0)").c_str());
     // Several rest densities: the mass density of a particle next to another phase is off by up to the
     // density ratio (docs/physics.md, the two-phase table), and the solver would drive that error to
     // zero with spurious interface pressures; the number density holds every phase at its own rho0.
     for (std::size_t k = 1; k < phases.size(); ++k)
       if (density == DensityFormulation::Mass && phases[k].rest_density != phases[0].rest_density) {
         std::ostringstream why;
-        why << "the DFSPH model needs the number density (density = number) for phases of different rest "
+        why << "the " << name
+            << " model needs the number density (density = number) for phases of different rest "
                "densities (phases[0].rest_density = "
             << phases[0].rest_density << ", phases[" << k << "].rest_density = " << phases[k].rest_density
             << ")";
@@ -177,12 +186,16 @@ void SolverConfig<Dim, Real>::validate() const {
 }
 
 std::string_view model_name(Model m) {
-  return m == Model::PaperMultiphase ? "paper" : m == Model::Wcsph ? "wcsph" : "dfsph";
+  return m == Model::PaperMultiphase ? "paper"
+         : m == Model::Wcsph         ? "wcsph"
+         : m == Model::Dfsph         ? "dfsph"
+                                     : "iisph";
 }
 std::optional<Model> parse_model(std::string_view n) {
   if (n == "paper") return Model::PaperMultiphase;
   if (n == "wcsph") return Model::Wcsph;
   if (n == "dfsph") return Model::Dfsph;
+  if (n == "iisph") return Model::Iisph;
   return std::nullopt;
 }
 std::string_view time_stepping_name(TimeStepping t) {

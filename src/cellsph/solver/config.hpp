@@ -23,7 +23,14 @@ enum class Model {
   PaperMultiphase,  // Onderik & Durikovic 2007, Algorithm 1: eq. 7-9, leap-frog eq. 11
   Wcsph,            // the CUDA write-up: operator splitting, symmetric pressure, symplectic Euler
   Dfsph,            // Bender & Koschier 2015/2017: divergence-free SPH, implicit pressure (models/dfsph.hpp)
+  Iisph,            // Ihmsen et al. 2014: implicit incompressible SPH, relaxed Jacobi (models/iisph.hpp)
 };
+
+// The models whose pressure is solved for (DFSPH and IISPH): they share the DFSPH passes, the settings
+// SolverConfig::dfsph, the Akinci walls and the run's solver statistics.
+constexpr bool implicit_pressure(Model m) {
+  return m == Model::Dfsph || m == Model::Iisph;
+}
 
 // How the paper's model obtains densities of neighbours of another phase.
 enum class DensityFormulation {
@@ -220,6 +227,8 @@ struct SolverConfig {
   // error of the constant-density solver in % of the rest density, the average divergence error of the
   // divergence-free solver in % of the rest density per step. min_iterations is the constant-density
   // solver's minimum (the divergence-free solver makes at least one sweep); both stop at max_iterations.
+  // Model::Iisph reads the same settings for its one solve (max_density_error, the iteration bounds, the
+  // warm start, wall_pressure) and `relaxation`; the scene gives them as /solver/iisph.
   struct Dfsph {
     Real max_density_error = Real(0.05);
     Real max_divergence_error = Real(0.1);
@@ -238,6 +247,8 @@ struct SolverConfig {
     // rho_i (g - a_b) . (x_b - x_i) ("hydrostatic", Adami's extrapolation, a_b a moving wall's acceleration,
     // applied once a step with the non-pressure forces).
     DfsphWallPressure wall_pressure = DfsphWallPressure::Zero;
+    // Model::Iisph only: the relaxation omega of its Jacobi iteration (Ihmsen et al. 2014: 0.5).
+    Real relaxation = Real(0.5);
     bool mirror_walls() const { return wall_pressure != DfsphWallPressure::Zero; }
   } dfsph{};
 

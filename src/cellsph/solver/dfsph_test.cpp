@@ -216,26 +216,11 @@ TEST(Dfsph, MirroredWallsSettleTheColumnAtLongerSteps) {
   EXPECT_LT(r.max_error, 0.5) << "density error in percent";
 }
 
-// The 2D dam break of the built-in scenes, coarse: a 0.5 x 1 m column in a closed 2 x 1.2 m tank of Akinci
-// walls. At the CFL steps (0.4 d / max |v|, at most 5 ms) no fluid particle leaves the tank, and every
-// solve keeps to its rules.
-struct DamBreak {
-  SolverConfig<2, double> cfg;
-  Particles<2, double> particles;
-  static constexpr double s = 0.025, L = 2.0, Ht = 1.2;
-};
-
+// The 2D dam break of the built-in scenes, coarse (test::DfsphDamBreak). At the CFL steps (0.4 d / max |v|,
+// at most 5 ms) no fluid particle leaves the tank, and every solve keeps to its rules.
+using DamBreak = test::DfsphDamBreak;
 DamBreak dam_break(Method method) {
-  DamBreak d;
-  d.cfg = dfsph_water<2, double>(DamBreak::s, 0.05, 0.005);
-  d.cfg.search.method = method;
-  d.cfg.domain_set = true;
-  d.cfg.domain_lo = V2{{-0.5, -0.5}};
-  d.cfg.domain_hi = V2{{DamBreak::L + 0.5, DamBreak::Ht + 0.5}};
-  add_block<2, double>(d.particles, V2{{0, 0}}, V2{{0.5, 1.0}}, DamBreak::s, 0);
-  add_box_walls<2, double>(d.particles, V2{{0, 0}}, V2{{DamBreak::L, DamBreak::Ht}}, DamBreak::s, 2, false, 0,
-                           0.0);
-  return d;
+  return test::dfsph_dam_break(method);
 }
 
 // Both wall pressures ("zero" and "mirrored").

@@ -679,7 +679,7 @@ void Simulation<Dim, Real>::step() {
 
   sw.reset();
   filter_lists(fluid_);
-  if (cfg_.model == Model::Dfsph) {
+  if (implicit_pressure(cfg_.model)) {
     step_dfsph(sw);
     return;
   }
@@ -738,7 +738,9 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
       fluid_, static_cast<std::size_t>(max_threads()),
       [&](std::uint32_t i) { return std::uint64_t{within_count_[i]} + kBalanceParticleWeight; },
       fluid_split_);
-  const Real dt = dfsph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1);
+  const Real dt = cfg_.model == Model::Iisph
+                      ? iisph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1)
+                      : dfsph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1);
   timings_.forces += sw.ms();
   sw.reset();
   inflow_hold(dt);
@@ -1099,7 +1101,7 @@ void Simulation<Dim, Real>::upload_to_device() {
   if (!moving_.empty() || !wall_a_.empty())
     device_->upload_wall_motion(moving_, moving_x0_, moving_motion_, wall_a_);
   if (bodies_.any()) device_->upload_bodies(bodies_);
-  if (cfg_.model == Model::Dfsph) device_->upload_solver_state(state_);
+  if (implicit_pressure(cfg_.model)) device_->upload_solver_state(state_);
 }
 
 // One step of the device backend (solver/device/device_stepper.hpp): the sequence of step() for WCSPH or
@@ -1118,7 +1120,7 @@ void Simulation<Dim, Real>::step_device() {
   }
   DeviceStepInput<Real> in{time_, last_dt_, leapfrog_started_};
   if (inflow_activity()) in.emitters_active = active_.data();
-  if (cfg_.model == Model::Dfsph) {
+  if (implicit_pressure(cfg_.model)) {
     if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);  // m, rho0: on the host
     in.step = steps_ + 1;
     in.dfsph_diameter = df_diameter_;
@@ -1152,7 +1154,7 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::sync_host() const {
   if (!host_stale_) return;
   device_->download(p_);
-  if (cfg_.model == Model::Dfsph) device_->download_solver_state(state_);
+  if (implicit_pressure(cfg_.model)) device_->download_solver_state(state_);
   host_stale_ = false;
 }
 

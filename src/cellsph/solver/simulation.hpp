@@ -5,6 +5,7 @@
 //    colour field and interface tension eq. 8c/9, leap-frog eq. 11).
 //  * Wcsph: the CUDA write-up's weakly compressible SPH with operator splitting and symplectic Euler.
 //  * Dfsph: Bender & Koschier's divergence-free SPH, pressure solved implicitly (models/dfsph.hpp).
+//  * Iisph: Ihmsen et al.'s implicit incompressible SPH on DFSPH's passes (models/iisph.hpp).
 //
 // Velocities: in the paper's model particles().v holds the leap-frog half-step velocity v(t - dt/2) once
 // the first step has run (eq. 11); in the WCSPH model it is v(t).
@@ -109,7 +110,8 @@ class Simulation {
   [[nodiscard]] const StepTimings& timings() const { return timings_; }
   [[nodiscard]] const SearchStats& search_stats() const { return search_.stats(); }
   [[nodiscard]] std::size_t fluid_count() const { return fluid_count_; }
-  // Model::Dfsph: iterations and errors of the pressure solves (models/dfsph.hpp).
+  // Model::Dfsph and Model::Iisph: iterations and errors of the pressure solves (models/dfsph.hpp,
+  // iisph.hpp).
   [[nodiscard]] const DfsphStats& dfsph_stats() const { return dfsph_stats_; }
 
   // Diagnostics over fluid particles.

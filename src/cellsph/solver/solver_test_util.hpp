@@ -48,6 +48,28 @@ SolverConfig<Dim, Real> dfsph_water(Real s, Real mu, Real dt_max) {
   return cfg;
 }
 
+// The DFSPH and IISPH tests' 2D dam break (solver/dfsph_test.cpp, iisph_test.cpp), the built-in scenes'
+// coarsened: a 0.5 x 1 m column in a closed 2 x 1.2 m tank of Akinci walls, dfsph_water at 0.025 m with
+// mu = 0.05 Pa s and steps of at most 5 ms, the search `method`.
+struct DfsphDamBreak {
+  SolverConfig<2, double> cfg;
+  Particles<2, double> particles;
+  static constexpr double s = 0.025, L = 2.0, Ht = 1.2;
+};
+inline DfsphDamBreak dfsph_dam_break(Method method) {
+  using V2 = Vec<2, double>;
+  DfsphDamBreak d;
+  d.cfg = dfsph_water<2, double>(DfsphDamBreak::s, 0.05, 0.005);
+  d.cfg.search.method = method;
+  d.cfg.domain_set = true;
+  d.cfg.domain_lo = V2{{-0.5, -0.5}};
+  d.cfg.domain_hi = V2{{DfsphDamBreak::L + 0.5, DfsphDamBreak::Ht + 0.5}};
+  add_block<2, double>(d.particles, V2{{0, 0}}, V2{{0.5, 1.0}}, DfsphDamBreak::s, 0);
+  add_box_walls<2, double>(d.particles, V2{{0, 0}}, V2{{DfsphDamBreak::L, DfsphDamBreak::Ht}},
+                           DfsphDamBreak::s, 2, false, 0, 0.0);
+  return d;
+}
+
 inline const char* dfsph_wall_pressure_name(DfsphWallPressure w) {
   return w == DfsphWallPressure::Hydrostatic ? "hydrostatic"
          : w == DfsphWallPressure::Mirrored  ? "mirrored"

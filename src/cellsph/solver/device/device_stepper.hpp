@@ -156,7 +156,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     sw.reset();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
     const bool holding = inflow_mark(in, fluid);
-    if (cfg_.model == Model::Dfsph) {
+    if (implicit_pressure(cfg_.model)) {
       r.dt = dfsph(in, fluid);
       Ops::synchronize();
       r.forces_ms = sw.ms();
@@ -319,6 +319,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       cg_ap_.resize(n_);
       cg_active_.resize(n_);
     }
+    if (cfg_.model == Model::Iisph)
+      return iisph_step(cfg_, view(), fluid, DeviceRange<Space>{n_}, in.dfsph_diameter, *in.dfsph, in.step);
     return dfsph_step(cfg_, view(), fluid, DeviceRange<Space>{n_}, in.dfsph_diameter, *in.dfsph, in.step);
   }
 

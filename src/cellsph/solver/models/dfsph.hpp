@@ -491,6 +491,56 @@ Real dfsph_particle_diameter(const ParticleView<Dim, Real>& pv, const IndexSet& 
   return fluid.empty() ? Real(0) : static_cast<Real>(std::pow(double(vmin), 1.0 / Dim));
 }
 
+// Step 2 (DFSPH and IISPH): the step from the velocities at its start: time.dt when the stepping is fixed,
+// else min(dt_max, courant * d / max |v|, viscous * d^2 / max nu).
+template <int Dim, class Real, class Set>
+Real implicit_step_size(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
+                        const Set& fluid, Real diameter) {
+  if (cfg.time.mode == TimeStepping::Fixed) return cfg.time.dt;
+  Real nu_max = 0;
+  for (const auto& ph : cfg.phases) nu_max = std::max(nu_max, ph.viscosity / ph.rest_density);
+  Real dt = cfg.time.dt_max;
+  const auto mx = reduce_max(fluid, CourantMaxima<Real>{}, CourantLimitsPass<Dim, Real>{pv, false});
+  if (mx.v2 > 0) dt = std::min(dt, cfg.time.courant * diameter / std::sqrt(mx.v2));
+  // Explicit viscosity: the limit on the particle spacing, not the support (measured: on h = 2 d the
+  // hydrostatic column at mu = 20 Pa s grew unstable at 0.4x the h-based limit).
+  if (nu_max > 0) dt = std::min(dt, cfg.time.viscous * diameter * diameter / nu_max);
+  return dt;
+}
+
+// Steps 1 and 2 (DFSPH and IISPH): w_j v_j and m_j k_j = 0 (mass density), the density pass with the
+// divergence solve's warm start `warm_divergence`, then the step size.
+template <int Dim, class Real, class Kernel, class Set, class All>
+Real implicit_density_and_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
+                               const Set& fluid, const All& all, const Kernel& w, Real diameter,
+                               const DfsphSourceRule<Real>& warm_divergence) {
+  const Real h = cfg.support;
+  Real rho0_min = std::numeric_limits<Real>::max();
+  for (const auto& ph : cfg.phases) rho0_min = std::min(rho0_min, ph.rest_density);
+  const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
+  const bool number = cfg.density == DensityFormulation::Number;
+  // The mass density's divergence warm start rides along the density pass (its rule does not read dt).
+  if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
+  run_pass(fluid, DfsphDensityFactorPass<Dim, Real, Kernel>{pv, w, denom_floor, number,
+                                                            cfg.dfsph.mirror_walls(), warm_divergence});
+  return implicit_step_size(cfg, pv, fluid, diameter);
+}
+
+// Step 4's pass (DFSPH and IISPH): gravity, the laminar viscosity and the hydrostatic walls' rise.
+template <int Dim, class Real, class Kernel>
+DfsphNonPressurePass<Dim, Real, Kernel> implicit_forces_pass(const SolverConfig<Dim, Real>& cfg,
+                                                             const ParticleView<Dim, Real>& pv,
+                                                             const Kernel& w) {
+  const Real h = cfg.support;
+  return {pv,
+          w,
+          cfg.gravity,
+          Real(0.01) * (h / 2) * (h / 2),
+          cfg.no_slip,
+          cfg.density == DensityFormulation::Number,
+          cfg.dfsph.wall_pressure == DfsphWallPressure::Hydrostatic};
+}
+
 // One DFSPH step of the particles of `fluid` (rows filtered to h, pv's DFSPH arrays sized for every
 // particle). `all` ranges over every particle, walls too (their df_mv and df_mk). Returns dt. Throws
 // SimulationError when a solve's error is not finite. `step` is the number of the step being taken
@@ -499,11 +549,6 @@ template <int Dim, class Real, class Set, class All>
 Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& fluid,
                 const All& all, Real diameter, DfsphStats& st, std::uint64_t step) {
   const Real h = cfg.support;
-  Real rho0_min = std::numeric_limits<Real>::max(), nu_max = 0;
-  for (const auto& ph : cfg.phases) {
-    rho0_min = std::min(rho0_min, ph.rest_density);
-    nu_max = std::max(nu_max, ph.viscosity / ph.rest_density);
-  }
   // A full neighbourhood holds about the support's volume over the particle volume; the divergence solve
   // leaves particles with fewer than 60% of that alone (SPlisHSPlasH's 20 of about 33 in 3D).
   const double ratio = double(h) / double(diameter);
@@ -518,24 +563,9 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
   with_kernel<Dim, Real>(cfg.density_kernel, h, [&](const auto w) {
     using K = std::remove_cvref_t<decltype(w)>;
     Stopwatch sw;
-    const Real denom_floor = Real(1e-9) * (rho0_min / h) * (rho0_min / h);
-    // The mass density's divergence warm start rides along the density pass (its rule does not read dt).
-    if (!number) run_pass(all, DfsphPairStatePass<Dim, Real>{pv});
-    run_pass(fluid, DfsphDensityFactorPass<Dim, Real, K>{
-                        pv, w, denom_floor, number, mirror,
-                        dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start,
-                                        kDfsphDivergenceWarmScale<Real>, min_neighbors)});
-    // The step from the velocities at its start.
-    if (cfg.time.mode == TimeStepping::Fixed) {
-      dt = cfg.time.dt;
-    } else {
-      dt = cfg.time.dt_max;
-      const auto mx = reduce_max(fluid, CourantMaxima<Real>{}, CourantLimitsPass<Dim, Real>{pv, false});
-      if (mx.v2 > 0) dt = std::min(dt, cfg.time.courant * diameter / std::sqrt(mx.v2));
-      // Explicit viscosity: the limit on the particle spacing, not the support (measured: on h = 2 d
-      // the hydrostatic column at mu = 20 Pa s grew unstable at 0.4x the h-based limit).
-      if (nu_max > 0) dt = std::min(dt, cfg.time.viscous * diameter * diameter / nu_max);
-    }
+    dt = implicit_density_and_step(cfg, pv, fluid, all, w, diameter,
+                                   dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start,
+                                                   kDfsphDivergenceWarmScale<Real>, min_neighbors));
     st.ms_factor += sw.ms();
     sw.reset();
 
@@ -554,14 +584,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
       }
     };
     // The divergence solve, which also sums the non-pressure forces (step 4) in its last source pass.
-    const DfsphNonPressurePass<Dim, Real, K> forces{
-        pv,
-        w,
-        cfg.gravity,
-        Real(0.01) * (h / 2) * (h / 2),
-        cfg.no_slip,
-        number,
-        cfg.dfsph.wall_pressure == DfsphWallPressure::Hydrostatic};
+    const DfsphNonPressurePass<Dim, Real, K> forces = implicit_forces_pass(cfg, pv, w);
     const DfsphSolveResult div =
         dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
                     cfg.dfsph.warm_start, kDfsphDivergenceWarmScale<Real>, min_neighbors, number, mirror,
@@ -604,5 +627,6 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
 }  // namespace cellsph
 
 // The CG density solve that dfsph_step calls when dfsph.density_solver is "cg" (it builds on the passes
-// above).
+// above), and IISPH's step (Model::Iisph), which runs them too.
 #include "cellsph/solver/models/dfsph_cg.hpp"  // IWYU pragma: export
+#include "cellsph/solver/models/iisph.hpp"     // IWYU pragma: export
