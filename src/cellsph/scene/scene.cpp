@@ -1480,8 +1480,8 @@ void set_view(Scene<Dim, Real>& s, const std::optional<Aabb<Dim>>& container) {
   s.view_hi = hi;
 }
 
-// A scene switched to DFSPH (`--set /solver/model=dfsph` on a WCSPH scene) may keep settings of the
-// other models that DFSPH refuses: one message names them all, with the --set edits that make the scene
+// A scene switched to DFSPH or IISPH (`--set /solver/model=dfsph` on a WCSPH scene) may keep settings of
+// the other models that they refuse: one message names them all, with the --set edits that make the scene
 // fit, rather than one refusal per run (docs/physics.md, "Model 3").
 void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
   const auto at = [](const nlohmann::json& o, const char* key) -> const nlohmann::json* {
@@ -1513,6 +1513,10 @@ void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
   if (const nlohmann::json* d = at(*solver, "density"); d && *d == "continuity")
     add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model)",
         "--set /solver/density=mass");
+  // A DFSPH scene switched to IISPH keeps its /solver/dfsph (IISPH's settings are /solver/iisph).
+  if (*model == "iisph" && at(*solver, "dfsph"))
+    add("/solver/dfsph is set (DFSPH's settings; IISPH takes its own, /solver/iisph)",
+        "--set /solver/dfsph=null");
   if (what.empty()) return;
   throw InputError(source + ": /solver/model = " + json_value_text(*model) +
                    " does not fit this scene's settings: " + what + ". Add: " + sets);
