@@ -15,6 +15,7 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/dfsph_test_checks.hpp"
 #include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
 #include "cellsph/solver/pass_driver.hpp"
@@ -581,23 +582,7 @@ TEST(Dfsph, CgDensitySolveHoldsTheDamBreakAndItsBits) {
   EXPECT_FALSE(test::same_state(a, j.particles())) << "the CG solve gave the Jacobi bits";
 }
 
-// 40 steps of the 2D dam break on the CPU and on the host-emulated device: the same bits, time, sweep counts
-// and divergence warm start. Returns the device's reorders.
-std::uint64_t expect_device_gives_the_cpus_run(const DamBreak& d) {
-  Simulation<2, double> cpu(d.cfg, d.particles);
-  Simulation<2, double> dev(d.cfg, d.particles);
-  dev.use_backend(Backend::HostDevice);
-  for (int k = 0; k < 40; ++k) {
-    cpu.step();
-    dev.step();
-  }
-  EXPECT_TRUE(test::same_state(cpu.particles(), dev.particles()));
-  EXPECT_EQ(cpu.time(), dev.time());
-  EXPECT_EQ(cpu.dfsph_stats().density_iterations, dev.dfsph_stats().density_iterations);
-  EXPECT_EQ(cpu.dfsph_stats().divergence_iterations, dev.dfsph_stats().divergence_iterations);
-  EXPECT_EQ(cpu.solver_state().dfsph_kappa_v, dev.solver_state().dfsph_kappa_v);
-  return dev.timings().reorders;
-}
+using test::expect_device_gives_the_cpus_run;
 
 // The device step (the host-emulated device: the CUDA backend's code path over host memory) gives the CPU's
 // bits, solver statistics included, and its divergence warm start travels with a checkpoint: a run started
@@ -606,16 +591,7 @@ TEST_P(DfsphWalls, HostDeviceIsBitIdenticalToTheCpuAndResumesAcrossBackends) {
   auto d = dam_break(Method::CellIndex);
   d.cfg.dfsph.wall_pressure = static_cast<DfsphWallPressure>(GetParam());
   expect_device_gives_the_cpus_run(d);
-  Simulation<2, double> cpu(d.cfg, d.particles);
-  for (int k = 0; k < 40; ++k) cpu.step();
-
-  Simulation<2, double> first(d.cfg, d.particles);
-  first.use_backend(Backend::HostDevice);
-  for (int k = 0; k < 20; ++k) first.step();
-  Simulation<2, double> resumed(d.cfg, d.particles);
-  resumed.restore(first.particles(), first.integrator_state(), "checkpoint", first.solver_state());
-  for (int k = 20; k < 40; ++k) resumed.step();
-  EXPECT_TRUE(test::same_state(resumed.particles(), cpu.particles()));
+  test::expect_device_run_resumes_on_the_cpu(d);
 }
 
 INSTANTIATE_TEST_SUITE_P(Dfsph, DfsphWalls, ::testing::Values(0, 1, 2),

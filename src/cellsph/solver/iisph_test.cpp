@@ -14,6 +14,7 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/dfsph_test_checks.hpp"
 #include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/simulation.hpp"
 #include "cellsph/solver/solver_test_util.hpp"
@@ -127,24 +128,8 @@ TEST_P(IisphWalls, DamBreakLosesNoParticleThroughTheWalls) {
 // started there resumes on the CPU from its checkpoint state as if uninterrupted.
 TEST_P(IisphWalls, HostDeviceIsBitIdenticalToTheCpuAndResumesAcrossBackends) {
   const auto d = dam_break(Method::CellIndex, static_cast<DfsphWallPressure>(GetParam()));
-  Simulation<2, double> cpu(d.cfg, d.particles);
-  Simulation<2, double> dev(d.cfg, d.particles);
-  dev.use_backend(Backend::HostDevice);
-  for (int k = 0; k < 40; ++k) {
-    cpu.step();
-    dev.step();
-  }
-  EXPECT_TRUE(test::same_state(cpu.particles(), dev.particles()));
-  EXPECT_EQ(cpu.time(), dev.time());
-  EXPECT_EQ(cpu.dfsph_stats().density_iterations, dev.dfsph_stats().density_iterations);
-
-  Simulation<2, double> first(d.cfg, d.particles);
-  first.use_backend(Backend::HostDevice);
-  for (int k = 0; k < 20; ++k) first.step();
-  Simulation<2, double> resumed(d.cfg, d.particles);
-  resumed.restore(first.particles(), first.integrator_state(), "checkpoint", first.solver_state());
-  for (int k = 20; k < 40; ++k) resumed.step();
-  EXPECT_TRUE(test::same_state(resumed.particles(), cpu.particles()));
+  test::expect_device_gives_the_cpus_run(d);
+  test::expect_device_run_resumes_on_the_cpu(d);
 }
 
 INSTANTIATE_TEST_SUITE_P(Iisph, IisphWalls, ::testing::Values(0, 1, 2),
