@@ -350,27 +350,13 @@ TEST(Dfsph, BitIdenticalAcrossRunsThreadsAndMethods) {
 // non-finite values).
 template <int Dim, class Real>
 void settle_small_column() {
-  using V = Vec<Dim, Real>;
-  const Real s = Real(0.05);
-  auto cfg = dfsph_water<Dim, Real>(s, Real(1), Real(0.01));
-  V lo{}, hi{}, top{};
-  for (int a = 0; a < Dim; ++a) {
-    hi[a] = Real(0.3);
-    top[a] = Real(0.3);
-  }
-  top[Dim - 1] = Real(0.4);
-  Particles<Dim, Real> p;
-  add_block<Dim, Real>(p, lo, hi, s, 0);
-  add_box_walls<Dim, Real>(p, lo, top, s, 2, true, 0, Real(0));
-  Simulation<Dim, Real> sim(cfg, p);
+  Simulation<Dim, Real> sim(dfsph_water<Dim, Real>(Real(0.05), Real(1), Real(0.01)),
+                            test::small_column<Dim, Real>());
   for (int k = 0; k < 40; ++k) {
     sim.step();
     expect_solver_rules(sim, "step " + std::to_string(k + 1));
   }
-  double kmax = 0;
-  for (std::size_t i = 0; i < sim.particles().size(); ++i)
-    kmax = std::max(kmax, double(norm(sim.particles().v[i])));
-  EXPECT_LT(kmax, 0.5) << "a column at rest should stay nearly at rest";
+  EXPECT_LT(test::max_speed(sim.particles()), 0.5) << "a column at rest should stay nearly at rest";
 }
 TEST(Dfsph, SmallColumn3DDouble) {
   settle_small_column<3, double>();

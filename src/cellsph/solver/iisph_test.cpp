@@ -156,21 +156,13 @@ TEST(Iisph, BitIdenticalAcrossRunsThreadsAndMethods) {
 
 // 3D float: a small column settles with every solve keeping its rules.
 TEST(Iisph, SmallColumn3DFloat) {
-  using V3 = Vec<3, float>;
-  const float s = 0.05f;
-  auto cfg = iisph(test::dfsph_water<3, float>(s, 1.0f, 0.01f));
-  Particles<3, float> p;
-  add_block<3, float>(p, V3{}, V3{{0.3f, 0.3f, 0.3f}}, s, 0);
-  add_box_walls<3, float>(p, V3{}, V3{{0.3f, 0.3f, 0.4f}}, s, 2, true, 0, 0.0f);
-  Simulation<3, float> sim(cfg, p);
+  Simulation<3, float> sim(iisph(test::dfsph_water<3, float>(0.05f, 1.0f, 0.01f)),
+                           test::small_column<3, float>());
   for (int k = 0; k < 40; ++k) {
     sim.step();
     expect_solve_rules(sim, "step " + std::to_string(k + 1));
   }
-  double vmax = 0;
-  for (std::size_t i = 0; i < sim.particles().size(); ++i)
-    vmax = std::max(vmax, double(norm(sim.particles().v[i])));
-  EXPECT_LT(vmax, 0.5) << "a column at rest should stay nearly at rest";
+  EXPECT_LT(test::max_speed(sim.particles()), 0.5) << "a column at rest should stay nearly at rest";
 }
 
 // Bad settings name the key (as the scene spells it) and the value.

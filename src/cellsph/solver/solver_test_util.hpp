@@ -1,5 +1,6 @@
 #pragma once
 // Shared by the solver tests only.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -68,6 +69,31 @@ inline DfsphDamBreak dfsph_dam_break(Method method) {
   add_box_walls<2, double>(d.particles, V2{{0, 0}}, V2{{DfsphDamBreak::L, DfsphDamBreak::Ht}},
                            DfsphDamBreak::s, 2, false, 0, 0.0);
   return d;
+}
+
+// The small resting column of the DFSPH and IISPH tests: water 0.3 m wide and deep at 0.05 m in an open tank
+// 0.4 m high of two layers of wall particles.
+template <int Dim, class Real>
+Particles<Dim, Real> small_column() {
+  using V = Vec<Dim, Real>;
+  V lo{}, hi{}, top{};
+  for (int a = 0; a < Dim; ++a) {
+    hi[a] = Real(0.3);
+    top[a] = Real(0.3);
+  }
+  top[Dim - 1] = Real(0.4);
+  Particles<Dim, Real> p;
+  add_block<Dim, Real>(p, lo, hi, Real(0.05), 0);
+  add_box_walls<Dim, Real>(p, lo, top, Real(0.05), 2, true, 0, Real(0));
+  return p;
+}
+
+// The largest particle speed.
+template <int Dim, class Real>
+double max_speed(const Particles<Dim, Real>& p) {
+  double vmax = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) vmax = std::max(vmax, double(norm(p.v[i])));
+  return vmax;
 }
 
 inline const char* dfsph_wall_pressure_name(DfsphWallPressure w) {
