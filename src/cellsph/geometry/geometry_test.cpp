@@ -107,7 +107,7 @@ TEST(MeshFile, QuadsAreSplitIntoTriangles) {
 }
 
 // PLY headers are checked before Assimp sees them: it loops without end on one whose end_header is in a
-// comment, and reserves what the counts announce.
+// comment, reserves what the counts announce, and frees memory twice on an element declared twice.
 TEST(MeshFile, MalformedPlyHeadersAreRefusedBeforeAssimp) {
   const std::pair<std::string, std::string> cases[] = {
       {"ply\nformat ascii 1.0\ncomment x end_header\n1 0 0\n", "PLY header line 4: unexpected \"1 0 0\""},
@@ -116,6 +116,23 @@ TEST(MeshFile, MalformedPlyHeadersAreRefusedBeforeAssimp) {
       {"ply\nformat ascii 1.0\nelement vertex 3\nend_header\n0 0 0\n1 0 0\n0 1 0\n", "no \"element face\""},
       {"ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header line"},
       {"plx\n", "is not a PLY file"},
+      // Assimp 5.2.5 freed memory twice on an element declared twice (fuzz/regressions/mesh).
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement vertex 3\nproperty float x\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0\n0\n1\n2\n3 0 1 2\n",
+       "PLY header line 5: element \"vertex\" is declared twice"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty floa x\nelement face 1\nend_header\n0\n1\n2\n3 0 1 "
+       "2\n",
+       "PLY header line 4: \"property floa x\" is not"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float\nelement face 1\nend_header\n0\n1\n2\n3 0 1 "
+       "2\n",
+       "PLY header line 4"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty list uchar vertex_indices\nelement face "
+       "1\nend_header\n"
+       "0\n1\n2\n3 0 1 2\n",
+       "PLY header line 4"},
+      {"ply\nformat ascii 1.0\nproperty float x\nelement vertex 3\nelement face 1\nend_header\n0\n1\n2\n3 0 "
+       "1 2\n",
+       "PLY header line 3: a property before any element"},
   };
   for (const auto& [text, mention] : cases) {
     try {

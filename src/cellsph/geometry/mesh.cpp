@@ -8,7 +8,9 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <string>
 #include <unordered_map>
+#include <vector>
 
 #ifndef CELLSPH_NO_ASSIMP  // the GPU check's build (cmake/gpu_check.cmake): no Assimp on that machine
 #include <assimp/config.h>
@@ -87,10 +89,33 @@ void check_stl(std::string_view b, const std::string& label) {
 // comment). So the header must be well formed before Assimp sees it: "ply", a "format" line, then only
 // comment, obj_info, element and property lines up to a line "end_header"; an "element vertex" and an
 // "element face"; and the counts no more than the bytes after the header (every element takes at least one).
+// Each element name once: a second "element vertex" made Assimp 5.2.5 free memory twice
+// (fuzz/regressions/mesh/ply-element-declared-twice). Each property after an element, of a PLY type, with
+// a name (a list: "property list COUNT_TYPE ITEM_TYPE NAME").
+bool ply_type(std::string_view t) {
+  static constexpr std::string_view kTypes[] = {"char",  "uchar",  "short",   "ushort", "int",   "uint",
+                                                "float", "double", "int8",    "uint8",  "int16", "uint16",
+                                                "int32", "uint32", "float32", "float64"};
+  return std::find(std::begin(kTypes), std::end(kTypes), t) != std::end(kTypes);
+}
+
+std::vector<std::string_view> words_of(std::string_view line) {
+  std::vector<std::string_view> w;
+  std::size_t k = 0;
+  while (k < line.size()) {
+    while (k < line.size() && (line[k] == ' ' || line[k] == '\t')) ++k;
+    const std::size_t start = k;
+    while (k < line.size() && line[k] != ' ' && line[k] != '\t') ++k;
+    if (k > start) w.push_back(line.substr(start, k - start));
+  }
+  return w;
+}
+
 void check_ply(std::string_view b, const std::string& label) {
   std::size_t pos = 0, line_no = 0, data = 0;
   double total = 0;
   bool vertex = false, face = false, ended = false, ascii = false;
+  std::vector<std::string> elements;
   while (pos < b.size() && !ended) {
     std::size_t nl = b.find('\n', pos);
     if (nl == std::string_view::npos) nl = b.size();
@@ -119,10 +144,25 @@ void check_ply(std::string_view b, const std::string& label) {
         count = count * 10 + (line[k] - '0');
       }
       if (!digits) fail(label, where + ": an element needs a name and a count");
+      const auto w = words_of(line);
+      if (w.size() != 3) fail(label, where + ": an element needs a name and a count");
+      if (std::find(elements.begin(), elements.end(), w[1]) != elements.end())
+        fail(label, where + ": element \"" + std::string(w[1]) + "\" is declared twice");
+      elements.emplace_back(w[1]);
       vertex = vertex || word("element vertex");
       face = face || word("element face");
       total += count;
-    } else if (!word("property") && !word("comment") && !word("obj_info")) {
+    } else if (word("property")) {
+      const auto w = words_of(line);
+      const bool list = w.size() > 1 && w[1] == "list";
+      const bool ok =
+          list ? w.size() == 5 && ply_type(w[2]) && ply_type(w[3]) : w.size() == 3 && ply_type(w[1]);
+      if (!ok)
+        fail(label,
+             where + ": \"" + std::string(line.substr(0, 40)) +
+                 "\" is not \"property TYPE NAME\" or \"property list TYPE TYPE NAME\" with PLY types");
+      if (elements.empty()) fail(label, where + ": a property before any element");
+    } else if (!word("comment") && !word("obj_info")) {
       fail(label, where + ": unexpected \"" + std::string(line.substr(0, 40)) + "\" in the header");
     }
   }
