@@ -136,16 +136,14 @@ void check_ply(std::string_view b, const std::string& label) {
       ended = true;
       data = b.size() - std::min(b.size(), pos);
     } else if (word("element")) {
-      const auto sp = line.rfind(' ');
+      const auto w = words_of(line);
+      bool digits = w.size() == 3;
       double count = 0;
-      bool digits = sp != std::string_view::npos && sp + 1 < line.size() && sp > 7;
-      for (std::size_t k = sp + 1; digits && k < line.size(); ++k) {
-        if (line[k] < '0' || line[k] > '9') digits = false;
-        count = count * 10 + (line[k] - '0');
+      for (std::size_t k = 0; digits && k < w[2].size(); ++k) {
+        if (w[2][k] < '0' || w[2][k] > '9') digits = false;
+        count = count * 10 + (w[2][k] - '0');
       }
       if (!digits) fail(label, where + ": an element needs a name and a count");
-      const auto w = words_of(line);
-      if (w.size() != 3) fail(label, where + ": an element needs a name and a count");
       if (std::find(elements.begin(), elements.end(), w[1]) != elements.end())
         fail(label, where + ": element \"" + std::string(w[1]) + "\" is declared twice");
       elements.emplace_back(w[1]);

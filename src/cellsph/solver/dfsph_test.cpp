@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -612,18 +613,33 @@ TEST(Dfsph, HostDeviceIsBitIdenticalToTheCpu3DFloat) {
   EXPECT_EQ(cpu.time(), dev.time());
 }
 
+// A solve whose error is not finite stops the run with a diagnosis naming the step, the solve, its sweeps
+// and dt; one left above its bound is counted with its step and error; one within it is not.
+TEST(Dfsph, SolveCheckDiagnosesDivergenceAndCountsMaxIterationHits) {
+  DfsphStats st;
+  implicit_check_solve(st, DfsphSolveResult{3, 0.0004}, 0.0005, 7, 0.001, "DFSPH constant-density", "sweeps");
+  EXPECT_EQ(st.max_iteration_hits, 0u);
+  implicit_check_solve(st, DfsphSolveResult{100, 0.002}, 0.0005, 9, 0.001, "DFSPH constant-density", "sweeps");
+  EXPECT_EQ(st.max_iteration_hits, 1u);
+  EXPECT_EQ(st.last_hit_step, 9u);
+  EXPECT_DOUBLE_EQ(st.last_hit_error, 0.2);
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    try {
+      implicit_check_solve(st, DfsphSolveResult{4, bad}, 0.001, 12, 0.0025, "IISPH pressure", "iterations");
+      ADD_FAILURE() << "no error for " << bad;
+    } catch (const SimulationError& e) {
+      EXPECT_STREQ(e.what(),
+                   "simulation unstable at step 12: the IISPH pressure solve diverged (average error not finite "
+                   "after 4 iterations, dt = 0.0025 s)");
+    }
+  }
+  EXPECT_EQ(st.max_iteration_hits, 1u);
+}
+
 // Bad settings name the key and the value.
 TEST(Dfsph, BadSettingsAreInputErrors) {
-  auto expect_error = [](auto edit, const std::string& key) {
-    auto cfg = dfsph_water<2, double>(0.02, 1.0, 0.01);
-    edit(cfg);
-    try {
-      cfg.validate();
-      ADD_FAILURE() << key << ": no error";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
-    }
-  };
+  const auto base = dfsph_water<2, double>(0.02, 1.0, 0.01);
+  auto expect_error = [&](auto edit, const std::string& key) { test::expect_edit_invalid(base, edit, key); };
   using C = SolverConfig<2, double>;
   expect_error([](C& c) { c.dfsph.max_density_error = 0; }, "dfsph.max_density_error = 0");
   expect_error([](C& c) { c.dfsph.max_density_error = -1; }, "dfsph.max_density_error = -1");

@@ -4,9 +4,13 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <string>
 #include <string_view>
 #include <type_traits>
 
+#include <gtest/gtest.h>
+
+#include "cellsph/core/error.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/particles.hpp"
@@ -28,6 +32,20 @@ bool same_state(const Particles<Dim, Real>& a, const Particles<Dim, Real>& b) {
     });
   });
   return same;
+}
+
+// Expects `base` edited by `edit` to fail validate() with an InputError whose message holds `mention` (the
+// key and the value it names).
+template <int Dim, class Real, class Edit>
+void expect_edit_invalid(const SolverConfig<Dim, Real>& base, Edit edit, const std::string& mention) {
+  SolverConfig<Dim, Real> cfg = base;
+  edit(cfg);
+  try {
+    cfg.validate();
+    ADD_FAILURE() << mention << ": no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
+  }
 }
 
 // Water at spacing s: cubic spline, h = 2 s, Akinci walls, Courant steps at most dt_max.

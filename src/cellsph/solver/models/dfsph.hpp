@@ -436,6 +436,25 @@ struct DfsphSolveResult {
   double error = 0;  // relative (not percent)
 };
 
+// What every implicit solve's result is checked for (DFSPH's two, IISPH's one): an error that is not finite
+// stops the run with a diagnosis naming the step, the solve (`what`, e.g. "DFSPH constant-density"), how many
+// `unit`s ("sweeps", "iterations") it took and dt; one left above its bound `eta` by max_iterations is
+// counted, with its step and error, for the summary's log line.
+inline void implicit_check_solve(DfsphStats& st, const DfsphSolveResult& r, double eta, std::uint64_t step,
+                                 double dt, const char* what, const char* unit) {
+  if (!std::isfinite(r.error)) {
+    std::ostringstream os;
+    os << "simulation unstable at step " << step << ": the " << what << " solve diverged (average error not "
+       << "finite after " << r.iterations << " " << unit << ", dt = " << dt << " s)";
+    throw SimulationError(os.str());
+  }
+  if (r.error > eta) {
+    ++st.max_iteration_hits;
+    st.last_hit_step = step;
+    st.last_hit_error = r.error * 100;
+  }
+}
+
 // The divergence solve's warm start: half the last step's k, as SPlisHSPlasH (the full sum, measured, set
 // the hydrostatic column and the dam break ringing). The density solve's is dfsph.warm_start_scale (0.5
 // by default).
@@ -569,27 +588,13 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     st.ms_factor += sw.ms();
     sw.reset();
 
-    auto check = [&](const DfsphSolveResult& r, double eta, const char* what) {
-      if (!std::isfinite(r.error)) {
-        std::ostringstream os;
-        os << "simulation unstable at step " << step << ": the DFSPH " << what
-           << " solve diverged (average error not finite after " << r.iterations << " sweeps, dt = " << dt
-           << " s)";
-        throw SimulationError(os.str());
-      }
-      if (r.error > eta) {
-        ++st.max_iteration_hits;
-        st.last_hit_step = step;
-        st.last_hit_error = r.error * 100;
-      }
-    };
     // The divergence solve, which also sums the non-pressure forces (step 4) in its last source pass.
     const DfsphNonPressurePass<Dim, Real, K> forces = implicit_forces_pass(cfg, pv, w);
     const DfsphSolveResult div =
         dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
                     cfg.dfsph.warm_start, kDfsphDivergenceWarmScale<Real>, min_neighbors, number, mirror,
                     !number, &forces);
-    check(div, eta_divergence, "divergence-free");
+    implicit_check_solve(st, div, eta_divergence, step, double(dt), "DFSPH divergence-free", "sweeps");
     st.ms_divergence += sw.ms();
     sw.reset();
 
@@ -605,7 +610,7 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
             : dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
                           cfg.dfsph.max_iterations, cfg.dfsph.warm_start, cfg.dfsph.warm_start_scale,
                           min_neighbors, number, mirror);
-    check(den, eta_density, "constant-density");
+    implicit_check_solve(st, den, eta_density, step, double(dt), "DFSPH constant-density", "sweeps");
     st.ms_density += sw.ms();
     sw.reset();
 

@@ -25,7 +25,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 #include <type_traits>
 
 #include "cellsph/core/error.hpp"
@@ -123,17 +122,7 @@ Real iisph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     const DfsphSolveResult r = iisph_solve(
         pv, fluid, w, dt, eta, cfg.dfsph.min_iterations, cfg.dfsph.max_iterations,
         cfg.dfsph.warm_start ? cfg.dfsph.warm_start_scale : Real(0), cfg.dfsph.relaxation, number, mirror);
-    if (!std::isfinite(r.error)) {
-      std::ostringstream os;
-      os << "simulation unstable at step " << step << ": the IISPH pressure solve diverged (average error "
-         << "not finite after " << r.iterations << " iterations, dt = " << dt << " s)";
-      throw SimulationError(os.str());
-    }
-    if (r.error > eta) {
-      ++st.max_iteration_hits;
-      st.last_hit_step = step;
-      st.last_hit_error = r.error * 100;
-    }
+    implicit_check_solve(st, r, eta, step, double(dt), "IISPH pressure", "iterations");
     st.ms_density += sw.ms();
     sw.reset();
 
