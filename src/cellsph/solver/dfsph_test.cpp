@@ -619,18 +619,21 @@ TEST(Dfsph, SolveCheckDiagnosesDivergenceAndCountsMaxIterationHits) {
   DfsphStats st;
   implicit_check_solve(st, DfsphSolveResult{3, 0.0004}, 0.0005, 7, 0.001, "DFSPH constant-density", "sweeps");
   EXPECT_EQ(st.max_iteration_hits, 0u);
-  implicit_check_solve(st, DfsphSolveResult{100, 0.002}, 0.0005, 9, 0.001, "DFSPH constant-density", "sweeps");
+  implicit_check_solve(st, DfsphSolveResult{100, 0.002}, 0.0005, 9, 0.001, "DFSPH constant-density",
+                       "sweeps");
   EXPECT_EQ(st.max_iteration_hits, 1u);
   EXPECT_EQ(st.last_hit_step, 9u);
   EXPECT_DOUBLE_EQ(st.last_hit_error, 0.2);
-  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     try {
       implicit_check_solve(st, DfsphSolveResult{4, bad}, 0.001, 12, 0.0025, "IISPH pressure", "iterations");
       ADD_FAILURE() << "no error for " << bad;
     } catch (const SimulationError& e) {
-      EXPECT_STREQ(e.what(),
-                   "simulation unstable at step 12: the IISPH pressure solve diverged (average error not finite "
-                   "after 4 iterations, dt = 0.0025 s)");
+      EXPECT_STREQ(
+          e.what(),
+          "simulation unstable at step 12: the IISPH pressure solve diverged (average error not finite "
+          "after 4 iterations, dt = 0.0025 s)");
     }
   }
   EXPECT_EQ(st.max_iteration_hits, 1u);
