@@ -285,6 +285,15 @@ TEST(Passes, StabilityCheckFindsTheFirstBadParticle) {
   const StabilityCheckPass<2, double> no_domain{pv, false, Vec<2, double>{{0.0, 0.0}},
                                                 Vec<2, double>{{1.0, 1.0}}, 0.05};
   EXPECT_EQ(first_where(all, no_domain), -1);
+  // A speed or an acceleration whose square overflows (the Courant step would be 0), finite as it is.
+  v[0] = Vec<2, double>{{1e150, 0.0}};
+  f[2] = Vec<2, double>{{0.0, 4e150}};  // m = 4: |a|^2 = 1e300
+  EXPECT_EQ(first_where(all, no_domain), -1);
+  f[2] = Vec<2, double>{{0.0, 1e110}};
+  l.m[2] = 1e-100;  // |f|^2 = 1e220 is finite, |a|^2 = 1e420 is not
+  EXPECT_EQ(first_where(all, no_domain), 2);
+  v[0] = Vec<2, double>{{1e160, 0.0}};
+  EXPECT_EQ(first_where(all, no_domain), 0);
 }
 
 }  // namespace

@@ -562,14 +562,34 @@ void Simulation<Dim, Real>::check_state() {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
   sync_host();
+  std::ostringstream os;
+  os.precision(9);
+  os << "simulation unstable at step " << steps_ + 1 << " (t = " << time_
+     << " s): " << describe_unstable(first);
+  throw SimulationError(os.str());
+}
+
+// An implicit solve that diverged (the SimulationError being handled, models/dfsph.hpp's
+// implicit_check_solve): rethrown with the first fluid particle (lowest index) that the stability check
+// finds bad, where there is one (a velocity the solve's kicks made non-finite). Called from a catch block.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::report_diverged_solve(const SimulationError& e) {
+  sync_host();
+  const std::int64_t first = first_where(fluid_, stability_check(cfg_, view()));
+  if (first < 0) throw;
+  throw SimulationError(std::string(e.what()) + "; the first bad particle: " + describe_unstable(first));
+}
+
+// What is wrong with fluid particle `first`: "particle i (id k): velocity = (...)" and the like.
+template <int Dim, class Real>
+std::string Simulation<Dim, Real>::describe_unstable(std::int64_t first) const {
   const auto check = stability_check(cfg_, ParticleView<Dim, Real>{});
   const V lo = check.lo, hi = check.hi;
   const Real margin = check.margin;
   const auto i = static_cast<std::size_t>(first);
   std::ostringstream os;
   os.precision(9);
-  os << "simulation unstable at step " << steps_ + 1 << " (t = " << time_ << " s): particle " << i << " (id "
-     << p_.id[i] << "): ";
+  os << "particle " << i << " (id " << p_.id[i] << "): ";
   auto vec = [&](const char* name, const V& v) {
     os << name << " = (";
     for (int a = 0; a < Dim; ++a) os << (a ? ", " : "") << v[a];
@@ -581,7 +601,13 @@ void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
     vec("velocity", p_.v[i]);
   else if (!all_finite(p_.f[i]))
     vec("force", p_.f[i]);
-  else if (!std::isfinite(p_.rho[i]))
+  else if (!std::isfinite(norm2(p_.v[i]))) {
+    vec("velocity", p_.v[i]);
+    os << ": its square overflows (the Courant step would be 0)";
+  } else if (!std::isfinite(norm2(p_.f[i]) / (p_.m[i] * p_.m[i]))) {
+    vec("force", p_.f[i]);
+    os << " on mass " << p_.m[i] << ": the acceleration's square overflows (the Courant step would be 0)";
+  } else if (!std::isfinite(p_.rho[i]))
     os << "density = " << p_.rho[i];
   else if (!(p_.rho[i] > 0)) {
     os << "density = " << p_.rho[i] << " is not positive";
@@ -600,7 +626,7 @@ void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
       os << "; the scene sets no /domain: the default is its starting particles' bounding box grown by its "
             "longest side on every side (set /domain for another)";
   }
-  throw SimulationError(os.str());
+  return os.str();
 }
 
 // Per-particle power-of-two steps (timestep/per_particle_levels.hpp): the clock T is the smallest
@@ -738,9 +764,14 @@ void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
       fluid_, static_cast<std::size_t>(max_threads()),
       [&](std::uint32_t i) { return std::uint64_t{within_count_[i]} + kBalanceParticleWeight; },
       fluid_split_);
-  const Real dt = cfg_.model == Model::Iisph
-                      ? iisph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1)
-                      : dfsph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1);
+  Real dt = 0;
+  try {
+    dt = cfg_.model == Model::Iisph
+             ? iisph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1)
+             : dfsph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1);
+  } catch (const SimulationError& e) {
+    report_diverged_solve(e);
+  }
   timings_.forces += sw.ms();
   sw.reset();
   inflow_hold(dt);
@@ -1126,7 +1157,13 @@ void Simulation<Dim, Real>::step_device() {
     in.dfsph_diameter = df_diameter_;
     in.dfsph = &dfsph_stats_;
   }
-  const DeviceStepResult<Real> r = device_->step(in);
+  DeviceStepResult<Real> r{};
+  try {
+    r = device_->step(in);
+  } catch (const SimulationError& e) {
+    host_stale_ = true;  // the device's particles, as the diverged solve left them
+    report_diverged_solve(e);
+  }
   if (cfg_.model == Model::PaperMultiphase) leapfrog_started_ = true;
   host_stale_ = true;
   timings_.neighbors += r.neighbors_ms;

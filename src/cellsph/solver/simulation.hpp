@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/core/error.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
@@ -193,6 +194,8 @@ class Simulation {
   void apply_walls();
   void check_state();
   [[noreturn]] void report_unstable(std::int64_t first) const;
+  [[noreturn]] void report_diverged_solve(const SimulationError& e);
+  [[nodiscard]] std::string describe_unstable(std::int64_t first) const;
   void step_device();
   void upload_to_device();
   void sync_host() const;

@@ -234,6 +234,25 @@ TEST(Solver, NonPositiveDensityStopsTheRun) {
   }
 }
 
+// A speed whose square overflows (finite, but the Courant step from it is 0) stops the run instead of
+// stepping by 0 for ever.
+TEST(Solver, SpeedWhoseSquareOverflowsStopsTheRun) {
+  auto cfg = base_config(Model::Wcsph);
+  cfg.time.mode = TimeStepping::Courant;
+  Particles<2, double> p;
+  add_particle<2, double>(p, V2{{0, 0}}, 0, ParticleKind::Fluid, 0, V2{{1e160, 0}});
+  Simulation<2, double> sim(cfg, p);
+  try {
+    for (int s = 0; s < 3; ++s) sim.step();
+    FAIL() << "no SimulationError; t = " << sim.time();
+  } catch (const SimulationError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("step 1 "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("particle 0 "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("its square overflows (the Courant step would be 0)"), std::string::npos) << msg;
+  }
+}
+
 TEST(Solver, RejectsBadInput) {
   auto cfg = base_config(Model::Wcsph);
   cfg.support = -1;

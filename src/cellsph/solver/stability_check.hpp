@@ -1,7 +1,8 @@
 #pragma once
 // After each step: a fluid particle with a non-finite quantity, a density that is not positive (a
 // continuity density driven through zero by a particle squeezed between wall layers: SPHERIC Test 2 with
-// Fourtakas diffusion went 529 -> 2824 -> -827 kg/m^3 before the particle left), or outside the domain
+// Fourtakas diffusion went 529 -> 2824 -> -827 kg/m^3 before the particle left), a speed or acceleration
+// whose square overflows (a Courant step of 0), or outside the domain
 // grown by one support, stops the run. The pass says whether particle i is bad; the driver reduces to the
 // lowest such index (deterministic), and only then does host code describe it (the SimulationError's
 // message).
@@ -23,6 +24,9 @@ struct StabilityCheckPass {
 
   CELLSPH_HD bool operator()(std::size_t i) const {
     if (!all_finite(pv.x[i]) || !all_finite(pv.v[i]) || !all_finite(pv.f[i])) return true;
+    // A speed or an acceleration whose square overflows Real: the Courant step (timestep/global_courant.hpp)
+    // would be 0, and the run would not advance.
+    if (!std::isfinite(norm2(pv.v[i])) || !std::isfinite(norm2(pv.f[i]) / (pv.m[i] * pv.m[i]))) return true;
     if (!std::isfinite(pv.rho[i]) || !std::isfinite(pv.p[i]) || !(pv.rho[i] > 0)) return true;
     if (escape)
       for (int a = 0; a < Dim; ++a)
