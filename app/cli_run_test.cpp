@@ -251,6 +251,43 @@ TEST(CliRun, UnstableRunStopsWithDiagnosisAndCode3) {
   EXPECT_TRUE(fs::exists(dir / "out" / "frame_00000.vtu")) << "frames written before the blow-up stay";
 }
 
+// A solve stopped at max_iterations above its bound gets a warning line naming the step, the solve, its
+// sweeps, the error reached and the bound, for the first ten such solves of a run; the progress line and
+// the summary count them all.
+TEST(CliRun, SolvesStoppedAtMaxIterationsAreLogged) {
+  TempDir dir;
+  // One sweep each, bounds no sweep meets: both solves of every step stop at max_iterations.
+  const auto r =
+      run_cli(dir, "run dam-break-2d-dfsph --steps 8 --fps 1 --format csv --out " + q(dir / "out") +
+                       " --set /solver/dfsph/min_iterations=1 --set /solver/dfsph/max_iterations=1"
+                       " --set /solver/dfsph/max_density_error=1e-9"
+                       " --set /solver/dfsph/max_divergence_error=1e-9");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<std::string> warnings;
+  for (std::size_t at = r.err.find("cellsph: warning: "); at != std::string::npos;
+       at = r.err.find("cellsph: warning: ", at + 1))
+    warnings.push_back(r.err.substr(at, r.err.find('\n', at) - at));
+  // Step 1 starts at rest, its divergence error 0: one solve; two in each later step. Ten in all by step 6.
+  ASSERT_EQ(warnings.size(), 6u) << r.err;
+  EXPECT_EQ(warnings[0].rfind("cellsph: warning: step 1 (t = 0.005 s): the DFSPH constant-density solve "
+                              "stopped at max_iterations (1 sweep) with average error ",
+                              0),
+            0u)
+      << warnings[0];
+  EXPECT_NE(warnings[0].find("%, above its bound 1e-09%"), std::string::npos) << warnings[0];
+  EXPECT_EQ(warnings[0].find("(and "), std::string::npos) << warnings[0];
+  EXPECT_EQ(warnings[1].rfind("cellsph: warning: step 2 (t = 0.01 s): ", 0), 0u) << warnings[1];
+  EXPECT_NE(warnings[1].find(", above its bound 1e-09% (and one more solve of this step)"), std::string::npos)
+      << warnings[1];
+  EXPECT_EQ(warnings[5].rfind("cellsph: warning: step 6 (t = 0.03 s): ", 0), 0u) << warnings[5];
+  EXPECT_NE(
+      warnings[5].find("; further ones are counted on the progress line and in the summary, not logged"),
+      std::string::npos)
+      << warnings[5];
+  EXPECT_NE(r.err.find(", 15 solves stopped at max_iterations (last: step 8, error "), std::string::npos)
+      << r.err;
+}
+
 TEST(CliRun, RenderWritesOnePngPerFrame) {
   TempDir dir;
   write_file(dir / "tiny.json", kTiny);

@@ -129,7 +129,43 @@ std::string dfsph_progress(const Simulation<Dim, Real>& sim) {
   else
     std::snprintf(buf, sizeof buf, "  dfsph %d+%d sweeps, err %.3f%%, dt %.3g ms", st.last_density_iterations,
                   st.last_divergence_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
-  return buf;
+  std::string line = buf;
+  if (st.max_iteration_hits > 0)
+    line += ", " + std::to_string(st.max_iteration_hits) + " solves at max_iterations";
+  return line;
+}
+
+// How many solves stopped at max_iterations get a warning line of their own; later ones are counted on the
+// progress line and in the summary, so that a run that keeps hitting the limit does not flood its log.
+constexpr std::uint64_t kMaxIterationWarnings = 10;
+
+// A warning line for each implicit solve that a step left above its bound at max_iterations
+// (models/dfsph.hpp's implicit_check_solve), up to kMaxIterationWarnings in a run. `seen` is the count of
+// such solves already reported on.
+template <int Dim, class Real>
+void warn_max_iterations(const Simulation<Dim, Real>& sim, Progress& progress, std::uint64_t& seen) {
+  const Model model = sim.config().model;
+  if (!implicit_pressure(model)) return;
+  const auto& st = sim.dfsph_stats();
+  const std::uint64_t before = seen;
+  seen = st.max_iteration_hits;
+  if (seen == before || before >= kMaxIterationWarnings) return;
+  const std::uint64_t others = seen - before - 1;
+  const std::string more = others == 0   ? ""
+                           : others == 1 ? " (and one more solve of this step)"
+                                         : " (and " + std::to_string(others) + " more solves of this step)";
+  const char* unit = model == Model::Iisph ? (st.last_hit_iterations == 1 ? "iteration" : "iterations")
+                                           : (st.last_hit_iterations == 1 ? "sweep" : "sweeps");
+  progress.finish();
+  std::fprintf(
+      stderr,
+      "cellsph: warning: step %llu (t = %.6g s): the %s solve stopped at max_iterations (%d %s) with "
+      "average error %.3g%%, above its bound %.3g%%%s%s\n",
+      static_cast<unsigned long long>(st.last_hit_step), double(sim.time()), st.last_hit_solve,
+      st.last_hit_iterations, unit, st.last_hit_error, st.last_hit_bound, more.c_str(),
+      seen >= kMaxIterationWarnings
+          ? "; further ones are counted on the progress line and in the summary, not logged"
+          : "");
 }
 
 std::string fmt(const char* f, double v) {
@@ -373,11 +409,13 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
     return double(sim.time()) >= os.end_time * (1 - 1e-12);
   };
+  std::uint64_t max_iteration_hits_seen = 0;
   try {
     sample_probes();
     write_due_frames();
     while (!done() && !g_stop_signal) {
       sim.step();
+      warn_max_iterations(sim, progress, max_iteration_hits_seen);
       sample_probes();
       write_due_frames();
       const double frac =

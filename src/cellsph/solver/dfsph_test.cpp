@@ -614,7 +614,7 @@ TEST(Dfsph, HostDeviceIsBitIdenticalToTheCpu3DFloat) {
 }
 
 // A solve whose error is not finite stops the run with a diagnosis naming the step, the solve, its sweeps
-// and dt; one left above its bound is counted with its step and error; one within it is not.
+// and dt; one left above its bound is counted with its step, sweeps, error and bound; one within it is not.
 TEST(Dfsph, SolveCheckDiagnosesDivergenceAndCountsMaxIterationHits) {
   DfsphStats st;
   implicit_check_solve(st, DfsphSolveResult{3, 0.0004}, 0.0005, 7, 0.001, "DFSPH constant-density", "sweeps");
@@ -624,6 +624,9 @@ TEST(Dfsph, SolveCheckDiagnosesDivergenceAndCountsMaxIterationHits) {
   EXPECT_EQ(st.max_iteration_hits, 1u);
   EXPECT_EQ(st.last_hit_step, 9u);
   EXPECT_DOUBLE_EQ(st.last_hit_error, 0.2);
+  EXPECT_DOUBLE_EQ(st.last_hit_bound, 0.05);
+  EXPECT_EQ(st.last_hit_iterations, 100);
+  EXPECT_STREQ(st.last_hit_solve, "DFSPH constant-density");
   for (const double bad :
        {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     try {

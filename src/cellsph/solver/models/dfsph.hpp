@@ -77,7 +77,10 @@ struct DfsphStats {
   double max_density_error = 0;          // the largest of last_density_error over the steps
   std::uint64_t max_iteration_hits = 0;  // solves stopped by max_iterations above their error bound
   std::uint64_t last_hit_step = 0;       // the step (1-based) of the last such solve
-  double last_hit_error = 0;             // and the error [%] it reached
+  double last_hit_error = 0;             // and the error [%] it reached,
+  double last_hit_bound = 0;             // its bound [%],
+  int last_hit_iterations = 0;           // its sweeps (or iterations)
+  const char* last_hit_solve = "";       // and which solve it was ("DFSPH constant-density"; a literal)
   // Wall time of the step's stages [ms, summed]: ms_divergence includes the non-pressure forces (summed in
   // the divergence solve's last pass), ms_nonpressure is their kick.
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
@@ -439,7 +442,8 @@ struct DfsphSolveResult {
 // What every implicit solve's result is checked for (DFSPH's two, IISPH's one): an error that is not finite
 // stops the run with a diagnosis naming the step, the solve (`what`, e.g. "DFSPH constant-density"), how many
 // `unit`s ("sweeps", "iterations") it took and dt; one left above its bound `eta` by max_iterations is
-// counted, with its step and error, for the summary's log line.
+// counted, and the last such solve kept (step, solve, sweeps, error and bound) for the run's warning lines
+// and summary (app/cmd_run.cpp).
 inline void implicit_check_solve(DfsphStats& st, const DfsphSolveResult& r, double eta, std::uint64_t step,
                                  double dt, const char* what, const char* unit) {
   if (!std::isfinite(r.error)) {
@@ -452,6 +456,9 @@ inline void implicit_check_solve(DfsphStats& st, const DfsphSolveResult& r, doub
     ++st.max_iteration_hits;
     st.last_hit_step = step;
     st.last_hit_error = r.error * 100;
+    st.last_hit_bound = eta * 100;
+    st.last_hit_iterations = r.iterations;
+    st.last_hit_solve = what;
   }
 }
 
