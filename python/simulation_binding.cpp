@@ -148,6 +148,7 @@ class SimBase {
   virtual void checkpoint(const fs::path& path) const = 0;
   virtual void restore(const fs::path& path) = 0;
   [[nodiscard]] virtual py::dict timings() const = 0;
+  [[nodiscard]] virtual py::object solver_stats() const = 0;
   virtual void use_backend(Backend b) = 0;
 
   [[nodiscard]] const PyScene& scene() const { return scene_; }
@@ -235,6 +236,35 @@ class SimImpl final : public SimBase {
     d["integration_ms"] = t.integration;
     d["reorder_ms"] = t.reorder;
     d["list_builds"] = t.list_builds;
+    return d;
+  }
+
+  // The implicit solves of DFSPH and IISPH (models/dfsph.hpp's DfsphStats), as `cellsph run`'s summary
+  // shows them; None for the explicit models.
+  [[nodiscard]] py::object solver_stats() const override {
+    if (!implicit_pressure(sim_.config().model)) return py::none();
+    const DfsphStats& st = sim_.dfsph_stats();
+    py::dict d;
+    d["steps"] = st.steps;
+    d["density_iterations"] = st.density_iterations;
+    d["divergence_iterations"] = st.divergence_iterations;
+    d["last_density_iterations"] = st.last_density_iterations;
+    d["last_divergence_iterations"] = st.last_divergence_iterations;
+    d["last_density_error_percent"] = st.last_density_error;
+    d["last_divergence_error_percent"] = st.last_divergence_error;
+    d["max_density_error_percent"] = st.max_density_error;
+    d["max_iteration_hits"] = st.max_iteration_hits;
+    if (st.max_iteration_hits > 0) {
+      py::dict hit;
+      hit["step"] = st.last_hit_step;
+      hit["solve"] = std::string(st.last_hit_solve);
+      hit["iterations"] = st.last_hit_iterations;
+      hit["error_percent"] = st.last_hit_error;
+      hit["bound_percent"] = st.last_hit_bound;
+      d["last_max_iteration_hit"] = hit;
+    } else {
+      d["last_max_iteration_hit"] = py::none();
+    }
     return d;
   }
 
@@ -545,7 +575,16 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
           "support, color, viscosity, phase, level, tick, kind, id) as copies in id order.")
       .def_property_readonly(
           "timings", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.timings(); }); },
-          "Wall-clock time per phase of all steps so far [ms].");
+          "Wall-clock time per phase of all steps so far [ms].")
+      .def_property_readonly(
+          "solver_stats",
+          [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.solver_stats(); }); },
+          "The implicit pressure solves (solver.model 'dfsph' or 'iisph') since this object was made: steps, "
+          "iterations summed (density_iterations, divergence_iterations; IISPH's in density_iterations) and "
+          "of the last step, the average density error of the last step and the largest [% of rest density], "
+          "the last divergence error [% per step], and the solves stopped at max_iterations above their bound "
+          "(max_iteration_hits; last_max_iteration_hit: its step, solve, iterations, error_percent, "
+          "bound_percent, or None). None for the explicit models.");
 }
 
 }  // namespace cellsph::python

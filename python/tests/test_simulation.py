@@ -257,3 +257,45 @@ def test_host_device_backend_gives_the_cpu_bits():
     for name in ("positions", "velocities", "density", "pressure"):
         a, b = getattr(cpu, name), getattr(dev, name)
         assert a.tobytes() == b.tobytes(), name
+
+
+def test_solver_stats_of_the_implicit_solves():
+    # One sweep each and bounds no sweep meets: every solve stops at max_iterations, but step 1's divergence
+    # solve, whose fluid starts at rest (error 0).
+    scene = cellsph.Scene.load("dam-break-2d-dfsph")
+    for pointer, value in [("min_iterations", 1), ("max_iterations", 1), ("max_density_error", 1e-9),
+                           ("max_divergence_error", 1e-9)]:
+        scene.set("/solver/dfsph/" + pointer, value)
+    sim = cellsph.Simulation(scene, threads=1)
+    st = sim.solver_stats
+    assert st["steps"] == 0 and st["max_iteration_hits"] == 0 and st["last_max_iteration_hit"] is None
+    sim.step(8)
+    st = sim.solver_stats
+    assert st["steps"] == 8
+    assert st["density_iterations"] == 8 and st["divergence_iterations"] == 8
+    assert st["last_density_iterations"] == 1 and st["last_divergence_iterations"] == 1
+    assert st["max_iteration_hits"] == 15
+    assert 0 < st["last_density_error_percent"] <= st["max_density_error_percent"]
+    hit = st["last_max_iteration_hit"]
+    assert hit["step"] == 8 and hit["solve"] == "DFSPH constant-density" and hit["iterations"] == 1
+    assert hit["error_percent"] == st["last_density_error_percent"] and hit["bound_percent"] == 1e-9
+    # The built-in scene's own bounds: the totals are the sums of the steps', and the solves counted at
+    # max_iterations are those that ended above their bound after max_iterations sweeps.
+    sim = cellsph.Simulation(cellsph.Scene.load("dam-break-2d-dfsph"), threads=1)
+    steps = []
+    for _ in range(5):
+        sim.step()
+        st = sim.solver_stats
+        steps.append((st["last_density_iterations"], st["last_density_error_percent"],
+                      st["last_divergence_iterations"], st["last_divergence_error_percent"]))
+    assert st["density_iterations"] == sum(s[0] for s in steps) >= 2 * 5  # min_iterations 2
+    assert st["divergence_iterations"] == sum(s[2] for s in steps)
+    assert st["max_density_error_percent"] == max(s[1] for s in steps)
+    stopped = [k + 1 for k, s in enumerate(steps) for its, err, bound in ((s[0], s[1], 0.05), (s[2], s[3], 0.1))
+               if err > bound]
+    assert all(steps[k - 1][0] == 100 or steps[k - 1][2] == 100 for k in stopped)
+    assert st["max_iteration_hits"] == len(stopped)
+    if stopped:
+        assert st["last_max_iteration_hit"]["step"] == stopped[-1]
+    assert cellsph.Simulation(cellsph.Scene.load("dam-break-2d").set("/spacing", 0.03), threads=1).solver_stats \
+        is None
