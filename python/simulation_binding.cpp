@@ -582,7 +582,8 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
           "The implicit pressure solves (solver.model 'dfsph' or 'iisph') since this object was made: steps, "
           "iterations summed (density_iterations, divergence_iterations; IISPH's in density_iterations) and "
           "of the last step, the average density error of the last step and the largest [% of rest density], "
-          "the last divergence error [% per step], and the solves stopped at max_iterations above their bound "
+          "the last divergence error [% per step], and the solves stopped at max_iterations above their "
+          "bound "
           "(max_iteration_hits; last_max_iteration_hit: its step, solve, iterations, error_percent, "
           "bound_percent, or None). None for the explicit models.");
 }
