@@ -669,7 +669,7 @@ TEST(Dfsph, DivergedSolveStopsTheRunNamingTheParticle) {
   EXPECT_NE(cpu.find("simulation unstable at step "), std::string::npos) << cpu;
   EXPECT_NE(
       cpu.find(
-          "the DFSPH divergence-free solve diverged (average error not finite after 1 sweeps, dt = 2e-21 s)"),
+          "the DFSPH divergence-free solve diverged (average error not finite after 1 sweep, dt = 2e-21 s)"),
       std::string::npos)
       << cpu;
   EXPECT_NE(cpu.find("; the first bad particle: particle "), std::string::npos) << cpu;

@@ -51,6 +51,7 @@
 #include <cstdint>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <type_traits>
 
 #include "cellsph/core/error.hpp"
@@ -448,8 +449,10 @@ inline void implicit_check_solve(DfsphStats& st, const DfsphSolveResult& r, doub
                                  double dt, const char* what, const char* unit) {
   if (!std::isfinite(r.error)) {
     std::ostringstream os;
+    const std::string units(unit);  // "sweeps" -> "1 sweep"
     os << "simulation unstable at step " << step << ": the " << what << " solve diverged (average error not "
-       << "finite after " << r.iterations << " " << unit << ", dt = " << dt << " s)";
+       << "finite after " << r.iterations << " "
+       << (r.iterations == 1 ? units.substr(0, units.size() - 1) : units) << ", dt = " << dt << " s)";
     throw SimulationError(os.str());
   }
   if (r.error > eta) {
