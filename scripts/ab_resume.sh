@@ -67,13 +67,17 @@ for edit in filter(None, (e.strip() for e in edits.split(";"))):
     for k in keys[:-1]:
         try:
             node = node[int(k)] if isinstance(node, list) else node[k]
-        except (KeyError, IndexError, ValueError):
+        except (KeyError, IndexError, ValueError, TypeError):
             sys.exit(f"ab_resume.sh: edit '{edit}': the scene has no '{k}' on the way to {pointer}")
     last = keys[-1]
     if isinstance(node, list):
+        if not (last.isdigit() and int(last) < len(node)):
+            sys.exit(f"ab_resume.sh: edit '{edit}': '{last}' is not an index of the list at {pointer}")
         node[int(last)] = v
-    else:
+    elif isinstance(node, dict):
         node[last] = v
+    else:
+        sys.exit(f"ab_resume.sh: edit '{edit}': the scene's value before '{last}' holds no keys")
 json.dump(run, open(path, "w"), indent=1)
 PY
 }
