@@ -3,7 +3,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build/release -j "$(nproc)" >/dev/null
+source scripts/lib/configure_release.sh
+# Only the program: the tests, benchmarks and Python module are scripts/test.sh's to build.
+cmake --build build/release -j "$(nproc)" --target cellsph >/dev/null
 if [ $# -eq 0 ]; then set -- run; fi
 exec build/release/cellsph "$@"

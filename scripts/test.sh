@@ -8,18 +8,8 @@ JOBS=${JOBS:-$(nproc)}
 # Tests run two at a time on 2 cores: OpenMP threads that spin while waiting would steal the core
 # the other test needs (a 2D test went from 0.4 s to 13 s that way).
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
-# A compiler cache where Debian's ccache is installed (optional: without it every build compiles in full).
-# Paths are taken relative to the checkout and the directory is left out of the hash, so a fresh clone in
-# another folder of the same machine reuses the objects of the last run: only what changed recompiles.
-LAUNCHER=()
-if command -v ccache >/dev/null; then
-  export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
-  LAUNCHER=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
-    -DCMAKE_CUDA_COMPILER_LAUNCHER=ccache)
-fi
-
 echo "== release build (with the CUDA backend where nvcc is found: compiled, not run; docs/gpu.md) =="
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release "${LAUNCHER[@]}" >/dev/null
+source scripts/lib/configure_release.sh  # also sets LAUNCHER (ccache) for the ASan build below
 cmake --build build/release -j "$JOBS"
 ctest --test-dir build/release -j "$JOBS" --output-on-failure
 
