@@ -22,124 +22,149 @@ template <class Real>
 void non_negative(const std::string& key, Real v) {
   if (!(std::isfinite(v) && v >= 0)) bad(key, v, "must be a finite number >= 0");
 }
-}  // namespace
-
+// The numbers: support, equation of state, phases, gravity and time-step settings.
 template <int Dim, class Real>
-void SolverConfig<Dim, Real>::validate() const {
-  positive("support", support);
-  positive("eos.stiffness", eos.stiffness);
-  if (eos.kind == EosKind::Tait) positive("eos.gamma", eos.gamma);
-  if (phases.empty()) bad("phases", "[]", "at least one phase is needed");
-  for (std::size_t k = 0; k < phases.size(); ++k) {
+void validate_numbers(const SolverConfig<Dim, Real>& c) {
+  positive("support", c.support);
+  positive("eos.stiffness", c.eos.stiffness);
+  if (c.eos.kind == EosKind::Tait) positive("eos.gamma", c.eos.gamma);
+  if (c.phases.empty()) bad("phases", "[]", "at least one phase is needed");
+  for (std::size_t k = 0; k < c.phases.size(); ++k) {
     const std::string p = "phases[" + std::to_string(k) + "].";
-    positive(p + "rest_density", phases[k].rest_density);
-    non_negative(p + "mass", phases[k].mass);
-    non_negative(p + "viscosity", phases[k].viscosity);
-    if (!std::isfinite(phases[k].color)) bad(p + "color", phases[k].color, "must be finite");
-    non_negative(p + "sigma", phases[k].sigma);
+    positive(p + "rest_density", c.phases[k].rest_density);
+    non_negative(p + "mass", c.phases[k].mass);
+    non_negative(p + "viscosity", c.phases[k].viscosity);
+    if (!std::isfinite(c.phases[k].color)) bad(p + "color", c.phases[k].color, "must be finite");
+    non_negative(p + "sigma", c.phases[k].sigma);
   }
-  non_negative("tension_threshold", tension_threshold);
-  non_negative("verlet_skin", verlet_skin);
+  non_negative("tension_threshold", c.tension_threshold);
+  non_negative("verlet_skin", c.verlet_skin);
   for (int a = 0; a < Dim; ++a)
-    if (!std::isfinite(gravity[a])) bad("gravity[" + std::to_string(a) + "]", gravity[a], "must be finite");
-  positive("time.dt", time.dt);
-  positive("time.dt_max", time.dt_max);
-  positive("time.courant", time.courant);
-  positive("time.viscous", time.viscous);
-  positive("time.force", time.force);
-  if (time.max_level < 0 || time.max_level > 40) bad("time.max_level", time.max_level, "must be in [0, 40]");
-  if (tension != TensionModel::Paper && model != Model::PaperMultiphase)
-    bad("tension", tension_model_name(tension),
+    if (!std::isfinite(c.gravity[a]))
+      bad("gravity[" + std::to_string(a) + "]", c.gravity[a], "must be finite");
+  positive("time.dt", c.time.dt);
+  positive("time.dt_max", c.time.dt_max);
+  positive("time.courant", c.time.courant);
+  positive("time.viscous", c.time.viscous);
+  positive("time.force", c.time.force);
+  if (c.time.max_level < 0 || c.time.max_level > 40)
+    bad("time.max_level", c.time.max_level, "must be in [0, 40]");
+}
+
+// The settings that need the paper model or global steps.
+template <int Dim, class Real>
+void validate_model_fit(const SolverConfig<Dim, Real>& c) {
+  if (c.tension != TensionModel::Paper && c.model != Model::PaperMultiphase)
+    bad("tension", tension_model_name(c.tension),
         "the WCSPH model has the write-up's Mueller tension; csf and akinci need the paper model (model = "
         "paper)");
-  if (time.mode == TimeStepping::PerParticle && model != Model::PaperMultiphase)
+  if (c.time.mode == TimeStepping::PerParticle && c.model != Model::PaperMultiphase)
     bad("time.mode", "per-particle", "per-particle steps need the paper model's leap-frog (model = paper)");
   // Wall states are computed from all fluid densities of a step; a per-particle sub-step has only some.
-  if (wall_model != WallModel::Akinci && time.mode == TimeStepping::PerParticle)
-    bad("boundary.model", wall_model_name(wall_model),
+  if (c.wall_model != WallModel::Akinci && c.time.mode == TimeStepping::PerParticle)
+    bad("boundary.model", wall_model_name(c.wall_model),
         "needs global steps (time.mode fixed or courant), not per-particle");
-  if (box.enabled) {
+}
+
+// The write-up's box and the paper's planes.
+template <int Dim, class Real>
+void validate_collisions(const SolverConfig<Dim, Real>& c) {
+  if (c.box.enabled) {
     for (int a = 0; a < Dim; ++a)
-      if (!(box.hi[a] - 2 * box.radius > box.lo[a]))
-        bad("box.hi[" + std::to_string(a) + "]", box.hi[a], "must exceed box.lo + 2 radius");
-    non_negative("box.radius", box.radius);
-    if (!(box.damping <= 0 && box.damping >= -1)) bad("box.damping", box.damping, "must be in [-1, 0]");
+      if (!(c.box.hi[a] - 2 * c.box.radius > c.box.lo[a]))
+        bad("box.hi[" + std::to_string(a) + "]", c.box.hi[a], "must exceed box.lo + 2 radius");
+    non_negative("box.radius", c.box.radius);
+    if (!(c.box.damping <= 0 && c.box.damping >= -1)) bad("box.damping", c.box.damping, "must be in [-1, 0]");
   }
-  for (std::size_t k = 0; k < planes.size(); ++k) {
-    const Real n2 = norm2(planes[k].normal);
+  for (std::size_t k = 0; k < c.planes.size(); ++k) {
+    const Real n2 = norm2(c.planes[k].normal);
     if (!(std::abs(n2 - 1) < Real(1e-3)))
       bad("planes[" + std::to_string(k) + "].normal", std::sqrt(n2), "must have unit length");
   }
-  if (!(restitution >= 0 && restitution <= 1)) bad("restitution", restitution, "must be in [0, 1]");
-  if (!(friction >= 0 && friction <= 1)) bad("friction", friction, "must be in [0, 1]");
-  if (density_evolution == DensityEvolution::Continuity && model != Model::Wcsph)
+  if (!(c.restitution >= 0 && c.restitution <= 1)) bad("restitution", c.restitution, "must be in [0, 1]");
+  if (!(c.friction >= 0 && c.friction <= 1)) bad("friction", c.friction, "must be in [0, 1]");
+}
+
+// Density evolution, density diffusion and artificial viscosity, and the models they need.
+template <int Dim, class Real>
+void validate_density(const SolverConfig<Dim, Real>& c) {
+  if (c.density_evolution == DensityEvolution::Continuity && c.model != Model::Wcsph)
     bad("density", "continuity", "the continuity equation needs the WCSPH model (model = wcsph)");
-  if (density_diffusion.kind != DensityDiffusion::None) {
-    if (density_evolution != DensityEvolution::Continuity)
-      bad("density_diffusion.kind", density_diffusion_name(density_diffusion.kind),
+  if (c.density_diffusion.kind != DensityDiffusion::None) {
+    if (c.density_evolution != DensityEvolution::Continuity)
+      bad("density_diffusion.kind", density_diffusion_name(c.density_diffusion.kind),
           "diffuses an integrated density: needs density = continuity");
-    if (!(std::isfinite(density_diffusion.delta) && density_diffusion.delta >= 0 &&
-          density_diffusion.delta <= 1))
-      bad("density_diffusion.delta", density_diffusion.delta, "must be in [0, 1]");
+    if (!(std::isfinite(c.density_diffusion.delta) && c.density_diffusion.delta >= 0 &&
+          c.density_diffusion.delta <= 1))
+      bad("density_diffusion.delta", c.density_diffusion.delta, "must be in [0, 1]");
   }
-  if (!(std::isfinite(artificial_viscosity.alpha) && artificial_viscosity.alpha >= 0 &&
-        artificial_viscosity.alpha <= 10))
-    bad("artificial_viscosity.alpha", artificial_viscosity.alpha, "must be in [0, 10]");
-  if (artificial_viscosity.alpha > 0 && model != Model::Wcsph)
-    bad("artificial_viscosity.alpha", artificial_viscosity.alpha,
+  if (!(std::isfinite(c.artificial_viscosity.alpha) && c.artificial_viscosity.alpha >= 0 &&
+        c.artificial_viscosity.alpha <= 10))
+    bad("artificial_viscosity.alpha", c.artificial_viscosity.alpha, "must be in [0, 10]");
+  if (c.artificial_viscosity.alpha > 0 && c.model != Model::Wcsph)
+    bad("artificial_viscosity.alpha", c.artificial_viscosity.alpha,
         "artificial viscosity is part of the WCSPH model (model = wcsph)");
-  if (implicit_pressure(model)) {
-    // IISPH's settings are SolverConfig::dfsph too; its messages name them as the scene does (iisph.*).
-    const std::string sec = model == Model::Iisph ? "iisph." : "dfsph.";
-    const std::string name = model == Model::Iisph ? "IISPH" : "DFSPH";
-    positive(sec + "max_density_error", dfsph.max_density_error);
-    if (model == Model::Dfsph) positive("dfsph.max_divergence_error", dfsph.max_divergence_error);
-    if (dfsph.min_iterations < 0) bad(sec + "min_iterations", dfsph.min_iterations, "must be >= 0");
-    if (dfsph.max_iterations < 1) bad(sec + "max_iterations", dfsph.max_iterations, "must be >= 1");
-    if (dfsph.min_iterations > dfsph.max_iterations)
-      bad(sec + "min_iterations", dfsph.min_iterations,
-          ("must not exceed " + sec + "max_iterations = " + std::to_string(dfsph.max_iterations)).c_str());
-    if (!(dfsph.warm_start_scale > 0 && dfsph.warm_start_scale <= 1))
-      bad(sec + "warm_start_scale", dfsph.warm_start_scale, "must be in (0, 1]");
-    if (model == Model::Iisph && !(dfsph.relaxation > 0 && dfsph.relaxation <= 1))
-      bad("iisph.relaxation", dfsph.relaxation, "must be in (0, 1]");
-    if (model == Model::Iisph && dfsph.density_solver != DfsphDensitySolver::Jacobi)
-      bad("dfsph.density_solver", "cg", "IISPH's solve is its relaxed Jacobi iteration");
-    // Several phases: the number density's system is not symmetric in k (its pair force weighs m_i^2 k_i
-    // and m_j^2 k_j), which CG needs.
-    if (dfsph.density_solver == DfsphDensitySolver::ConjugateGradient &&
-        density == DensityFormulation::Number)
-      bad("dfsph.density_solver", "cg",
-          "the conjugate-gradient solve needs the mass density of one phase; several phases (density = "
-          "number) take \"jacobi\"");
-    // Adami and dynamic walls take their pressure from the fluid's (extrapolated) or from an equation of
-    // state; neither is an unknown of the DFSPH solves, so the factor alpha_i would not describe what a
-    // sweep changes (docs/physics.md, "DFSPH").
-    if (wall_model != WallModel::Akinci)
-      bad("boundary.model", wall_model_name(wall_model),
-          ("the " + name + " model supports Akinci 2012 boundary particles only (boundary.model = akinci)")
-              .c_str());
-    for (std::size_t k = 0; k < phases.size(); ++k)
-      if (phases[k].sigma > 0)
-        bad("phases[" + std::to_string(k) + "].sigma", phases[k].sigma,
-            ("the " + name + " model has no surface tension yet (sigma must be 0)").c_str());
-    // Several rest densities: the mass density of a particle next to another phase is off by up to the
-    // density ratio (docs/physics.md, the two-phase table), and the solver would drive that error to
-    // zero with spurious interface pressures; the number density holds every phase at its own rho0.
-    for (std::size_t k = 1; k < phases.size(); ++k)
-      if (density == DensityFormulation::Mass && phases[k].rest_density != phases[0].rest_density) {
-        std::ostringstream why;
-        why << "the " << name
-            << " model needs the number density (density = number) for phases of different rest "
-               "densities (phases[0].rest_density = "
-            << phases[0].rest_density << ", phases[" << k << "].rest_density = " << phases[k].rest_density
-            << ")";
-        bad("density", "mass", why.str().c_str());
-      }
-  }
-  if (search.subdivision < 1) bad("search.subdivision", search.subdivision, "must be >= 1");
-  for (std::size_t k = 0; k < wall_motion.motions.size(); ++k) {
-    const WallMotion& m = wall_motion.motions[k];
+}
+
+// DFSPH and IISPH: their solves' settings and what they do not support.
+template <int Dim, class Real>
+void validate_implicit(const SolverConfig<Dim, Real>& c) {
+  if (!implicit_pressure(c.model)) return;
+  // IISPH's settings are SolverConfig::dfsph too; its messages name them as the scene does (iisph.*).
+  const std::string sec = c.model == Model::Iisph ? "iisph." : "dfsph.";
+  const std::string name = c.model == Model::Iisph ? "IISPH" : "DFSPH";
+  positive(sec + "max_density_error", c.dfsph.max_density_error);
+  if (c.model == Model::Dfsph) positive("dfsph.max_divergence_error", c.dfsph.max_divergence_error);
+  if (c.dfsph.min_iterations < 0) bad(sec + "min_iterations", c.dfsph.min_iterations, "must be >= 0");
+  if (c.dfsph.max_iterations < 1) bad(sec + "max_iterations", c.dfsph.max_iterations, "must be >= 1");
+  if (c.dfsph.min_iterations > c.dfsph.max_iterations)
+    bad(sec + "min_iterations", c.dfsph.min_iterations,
+        ("must not exceed " + sec + "max_iterations = " + std::to_string(c.dfsph.max_iterations)).c_str());
+  if (!(c.dfsph.warm_start_scale > 0 && c.dfsph.warm_start_scale <= 1))
+    bad(sec + "warm_start_scale", c.dfsph.warm_start_scale, "must be in (0, 1]");
+  if (c.model == Model::Iisph && !(c.dfsph.relaxation > 0 && c.dfsph.relaxation <= 1))
+    bad("iisph.relaxation", c.dfsph.relaxation, "must be in (0, 1]");
+  if (c.model == Model::Iisph && c.dfsph.density_solver != DfsphDensitySolver::Jacobi)
+    bad("dfsph.density_solver", "cg", "IISPH's solve is its relaxed Jacobi iteration");
+  // Several phases: the number density's system is not symmetric in k (its pair force weighs m_i^2 k_i
+  // and m_j^2 k_j), which CG needs.
+  if (c.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient &&
+      c.density == DensityFormulation::Number)
+    bad("dfsph.density_solver", "cg",
+        "the conjugate-gradient solve needs the mass density of one phase; several phases (density = "
+        "number) take \"jacobi\"");
+  // Adami and dynamic walls take their pressure from the fluid's (extrapolated) or from an equation of
+  // state; neither is an unknown of the DFSPH solves, so the factor alpha_i would not describe what a
+  // sweep changes (docs/physics.md, "DFSPH").
+  if (c.wall_model != WallModel::Akinci)
+    bad("boundary.model", wall_model_name(c.wall_model),
+        ("the " + name + " model supports Akinci 2012 boundary particles only (boundary.model = akinci)")
+            .c_str());
+  for (std::size_t k = 0; k < c.phases.size(); ++k)
+    if (c.phases[k].sigma > 0)
+      bad("phases[" + std::to_string(k) + "].sigma", c.phases[k].sigma,
+          ("the " + name + " model has no surface tension yet (sigma must be 0)").c_str());
+  // Several rest densities: the mass density of a particle next to another phase is off by up to the
+  // density ratio (docs/physics.md, the two-phase table), and the solver would drive that error to
+  // zero with spurious interface pressures; the number density holds every phase at its own rho0.
+  for (std::size_t k = 1; k < c.phases.size(); ++k)
+    if (c.density == DensityFormulation::Mass && c.phases[k].rest_density != c.phases[0].rest_density) {
+      std::ostringstream why;
+      why << "the " << name
+          << " model needs the number density (density = number) for phases of different rest "
+             "densities (phases[0].rest_density = "
+          << c.phases[0].rest_density << ", phases[" << k << "].rest_density = " << c.phases[k].rest_density
+          << ")";
+      bad("density", "mass", why.str().c_str());
+    }
+}
+
+// The search subdivision and the moving walls.
+template <int Dim, class Real>
+void validate_motion(const SolverConfig<Dim, Real>& c) {
+  if (c.search.subdivision < 1) bad("search.subdivision", c.search.subdivision, "must be >= 1");
+  for (std::size_t k = 0; k < c.wall_motion.motions.size(); ++k) {
+    const WallMotion& m = c.wall_motion.motions[k];
     const std::string key = "wall_motion[" + std::to_string(k) + "].";
     if (m.kind == MotionKind::Oscillate) {
       positive(key + "period", m.period);
@@ -148,41 +173,64 @@ void SolverConfig<Dim, Real>::validate() const {
     if ((m.kind == MotionKind::Translate || m.kind == MotionKind::Rotate) && !(m.end >= m.start))
       bad(key + "end", m.end, "must not be before start");
     if (m.kind == MotionKind::Table &&
-        !(m.table_begin < m.table_end && m.table_end <= wall_motion.rows.size()))
+        !(m.table_begin < m.table_end && m.table_end <= c.wall_motion.rows.size()))
       bad(key + "table", m.table_end, "names no rows of the motion tables");
   }
-  for (const std::int32_t m : wall_motion.of_particle)
-    if (m < -1 || (m >= 0 && static_cast<std::size_t>(m) >= wall_motion.motions.size()))
+  for (const std::int32_t m : c.wall_motion.of_particle)
+    if (m < -1 || (m >= 0 && static_cast<std::size_t>(m) >= c.wall_motion.motions.size()))
       bad("wall_motion.of_particle", m, "is not -1 or a motion's index");
-  if (wall_motion.any() && time.mode == TimeStepping::PerParticle)
+  if (c.wall_motion.any() && c.time.mode == TimeStepping::PerParticle)
     bad("time.mode", "per-particle", "moving walls need global time steps (fixed or courant)");
-  if (rigid_bodies.any()) {
-    if (model != Model::Wcsph)
-      bad("model", model_name(model),
+}
+
+// Floating bodies.
+template <int Dim, class Real>
+void validate_bodies(const SolverConfig<Dim, Real>& c) {
+  if (c.rigid_bodies.any()) {
+    if (c.model != Model::Wcsph)
+      bad("model", model_name(c.model),
           "floating bodies need the WCSPH model (solver.model = wcsph): their force is its wall term");
-    if (time.mode == TimeStepping::PerParticle)
+    if (c.time.mode == TimeStepping::PerParticle)
       bad("time.mode", "per-particle", "floating bodies need global time steps (fixed or courant)");
-    if (wall_model == WallModel::Dynamic)
+    if (c.wall_model == WallModel::Dynamic)
       bad("boundary.model", "dynamic",
           "floating bodies need akinci or adami walls (dynamic walls keep a wall-wall density of walls at "
           "rest)");
-    positive("rigid_bodies.contact_distance", rigid_bodies.contact_distance);
-    non_negative("rigid_bodies.contact_frequency", rigid_bodies.contact_frequency);
-    non_negative("rigid_bodies.contact_damping", rigid_bodies.contact_damping);
-    for (std::size_t k = 0; k < rigid_bodies.bodies.size(); ++k) {
-      const RigidBody& b = rigid_bodies.bodies[k];
+    positive("rigid_bodies.contact_distance", c.rigid_bodies.contact_distance);
+    non_negative("rigid_bodies.contact_frequency", c.rigid_bodies.contact_frequency);
+    non_negative("rigid_bodies.contact_damping", c.rigid_bodies.contact_damping);
+    for (std::size_t k = 0; k < c.rigid_bodies.bodies.size(); ++k) {
+      const RigidBody& b = c.rigid_bodies.bodies[k];
       const std::string key = "rigid_bodies[" + std::to_string(k) + "].";
       positive(key + "mass", b.mass);
       for (int a = 0; a < 3; ++a) positive(key + "inertia", b.inertia[4 * a]);
     }
-    for (const std::int32_t b : rigid_bodies.of_particle)
-      if (b < -1 || (b >= 0 && static_cast<std::size_t>(b) >= rigid_bodies.bodies.size()))
+    for (const std::int32_t b : c.rigid_bodies.of_particle)
+      if (b < -1 || (b >= 0 && static_cast<std::size_t>(b) >= c.rigid_bodies.bodies.size()))
         bad("rigid_bodies.of_particle", b, "is not -1 or a body's index");
   }
-  if (const std::string err = inflow_config_error(inflow, Dim, phases.size()); !err.empty())
+}
+
+// Emitters and sinks.
+template <int Dim, class Real>
+void validate_inflow(const SolverConfig<Dim, Real>& c) {
+  if (const std::string err = inflow_config_error(c.inflow, Dim, c.phases.size()); !err.empty())
     throw InputError(err);
-  if (inflow.any() && time.mode == TimeStepping::PerParticle)
+  if (c.inflow.any() && c.time.mode == TimeStepping::PerParticle)
     bad("time.mode", "per-particle", "emitters and sinks need global time steps (fixed or courant)");
+}
+}  // namespace
+
+template <int Dim, class Real>
+void SolverConfig<Dim, Real>::validate() const {
+  validate_numbers(*this);
+  validate_model_fit(*this);
+  validate_collisions(*this);
+  validate_density(*this);
+  validate_implicit(*this);
+  validate_motion(*this);
+  validate_bodies(*this);
+  validate_inflow(*this);
 }
 
 std::string_view model_name(Model m) {
