@@ -16,14 +16,16 @@
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/physics/kernels.hpp"
-#include "cellsph/solver/boundary/adami2012.hpp"
 #include "cellsph/solver/boundary/akinci2012.hpp"
 #include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
+#include "cellsph/solver/boundary/wall_states.hpp"
+#include "cellsph/solver/cell_order.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
 #include "cellsph/solver/models/continuity_density.hpp"
-#include "cellsph/solver/models/paper_multiphase.hpp"
-#include "cellsph/solver/models/summation_density.hpp"
+#include "cellsph/solver/models/density_pressure.hpp"
+#include "cellsph/solver/models/model_registry.hpp"
+#include "cellsph/solver/models/paper_stepper.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
 #include "cellsph/solver/pass_driver.hpp"
 #include "cellsph/solver/stability_check.hpp"
@@ -54,17 +56,6 @@ std::string id_permutation_error(const std::vector<std::uint32_t>& id) {
   return {};
 }
 
-// Z-order (Morton) key of a cell: the bits of the cell coordinates interleaved, so that cells close in
-// space are mostly close in the key and each block of 2^Dim, 4^Dim, ... cells is contiguous.
-template <int Dim>
-std::uint64_t morton_key(const std::uint64_t (&c)[Dim]) {
-  constexpr int bits = 64 / Dim;
-  std::uint64_t key = 0;
-  for (int b = 0; b < bits; ++b)
-    for (int a = 0; a < Dim; ++a) key |= ((c[a] >> b) & 1u) << (b * Dim + a);
-  return key;
-}
-
 // The step's search: the wall particles search with support 0 (search_h_) and no pass reads their rows,
 // so Cell Indexing leaves them empty instead of searching them.
 SearchOptions step_search(SearchOptions o) {
@@ -74,13 +65,58 @@ SearchOptions step_search(SearchOptions o) {
 
 }  // namespace
 
+// What a model's stepper (models/model_stepper.hpp) sees of the CPU backend: the Simulation's arrays, the
+// fluid's index list (and its split by row length), the wall states and floating bodies' loads, the
+// leap-frog clock and the step's timings.
 template <int Dim, class Real>
-Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
-    : cfg_(std::move(config)), p_(std::move(particles)), search_(step_search(cfg_.search)) {
-  cfg_.validate();
-  for (const auto& ph : cfg_.phases) phase_params_.push_back({ph.rest_density, ph.viscosity, ph.sigma});
+class HostStepContext {
+ public:
+  template <class T>
+  using Array = std::vector<T>;
+
+  HostStepContext(Simulation<Dim, Real>& s, Stopwatch& sw) : s_(s), sw_(sw) {}
+  [[nodiscard]] const SolverConfig<Dim, Real>& cfg() const { return s_.cfg_; }
+  [[nodiscard]] ParticleView<Dim, Real> view() { return s_.view(); }
+  [[nodiscard]] const IndexSet& fluid() const { return s_.fluid_; }
+  [[nodiscard]] const BalancedIndexSet& fluid_by_pairs() { return s_.fluid_by_pairs(); }
+  [[nodiscard]] std::size_t all() const { return s_.p_.size(); }
+  [[nodiscard]] std::size_t size() const { return s_.p_.size(); }
+  [[nodiscard]] std::size_t fluid_count() const { return s_.fluid_.size(); }
+  [[nodiscard]] std::size_t pair_slots() const { return s_.nl_.indices.size(); }
+  void density(const ParticleView<Dim, Real>& pv) { fluid_density_pressure(s_.cfg_, pv, s_.fluid_); }
+  void wall_states(const ParticleView<Dim, Real>& pv) {
+    if (s_.wall_states_) cellsph::wall_states(s_.cfg_, pv, s_.boundary_);
+  }
+  void body_loads(const ParticleView<Dim, Real>& pv) {
+    if (s_.bodies_.any()) s_.compute_body_loads(pv);
+  }
+  [[nodiscard]] bool any_tension() const { return s_.any_tension_; }
+  [[nodiscard]] bool wall_states_on() const { return s_.wall_states_; }
+  [[nodiscard]] Real particle_diameter() {
+    if (s_.particle_diameter_ == 0) s_.particle_diameter_ = dfsph_particle_diameter(s_.view(), s_.fluid_);
+    return s_.particle_diameter_;
+  }
+  [[nodiscard]] std::uint64_t step_number() const { return s_.steps_ + 1; }
+  [[nodiscard]] LeapFrogClock<Real>& clock() { return s_.clock_; }
+  void forces_done() {
+    s_.timings_.forces += sw_.ms();
+    sw_.reset();
+  }
+  void count_density(std::size_t n) { s_.timings_.density_evals += n; }
+  void count_forces(std::size_t n) { s_.timings_.force_evals += n; }
+  void count_normals(std::size_t n) { s_.timings_.normal_evals += n; }
+
+ private:
+  Simulation<Dim, Real>& s_;
+  Stopwatch& sw_;
+};
+
+// The particles' inputs completed (those that may be left empty get their defaults; any other size
+// mismatch is an InputError) and the fields the Simulation sets cleared. Returns the input densities a
+// continuity run starts from (empty otherwise).
+template <int Dim, class Real>
+std::vector<Real> Simulation<Dim, Real>::complete_fields() {
   const std::size_t n = p_.x.size();
-  // Inputs that may be left empty get their defaults; any other size mismatch is an error.
   auto complete = [n](auto& field, const char* name, auto value) {
     if (field.empty()) field.assign(n, value);
     if (field.size() != n) {
@@ -116,41 +152,14 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   }
   complete(p_.id, "id", std::uint32_t{0});
   if (const auto err = id_permutation_error(p_.id); !err.empty()) throw InputError("particles: " + err);
-  rho0_.assign(n, Real(0));
-  state_.assign_zero(n);
-  // Emitters: frames from the config; the first layer is due at the start (advance = one spacing), so
-  // the emitted lattice continues a fluid block that begins at the emitter plane.
-  next_id_ = n;
-  for (std::size_t k = 0; k < cfg_.inflow.emitters.size(); ++k) {
-    const Emitter& e = cfg_.inflow.emitters[k];
-    const auto& phase = cfg_.phases[static_cast<std::size_t>(e.phase)];
-    if (!(phase.mass > 0 && std::isfinite(phase.mass)))
-      throw InputError("emitters[" + std::to_string(k) + "].phase: phase '" + phase.name + "' has mass " +
-                       std::to_string(phase.mass) + " (phases[" + std::to_string(e.phase) +
-                       "].mass): emitted particles need one > 0");
-    frames_.push_back(emitter_frame<Dim, Real>(e, cfg_.inflow.spacing, double(cfg_.support)));
-    emitter_planes_.push_back(frames_.back());
-    advance_.push_back(cfg_.inflow.spacing);
-  }
-  // Moving walls: each particle's motion and initial position, kept by id (the input order's index is
-  // lost when the boundary is reordered below).
-  if (cfg_.wall_motion.any()) {
-    const auto& of = cfg_.wall_motion.of_particle;
-    if (of.size() != n)
-      throw InputError("particles: the wall motions name " + std::to_string(of.size()) +
-                       " particles, there are " + std::to_string(n));
-    x0_of_id_.assign(n, V{});
-    motion_of_id_.assign(n, -1);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (of[i] >= 0 && p_.kind[i] != kBoundary)
-        throw InputError("particles: fluid particle " + std::to_string(i) + " is given a wall motion");
-      x0_of_id_[p_.id[i]] = p_.x[i];
-      motion_of_id_[p_.id[i]] = of[i];
-    }
-  }
-  // Floating bodies: each body particle's offset from its body's centre, kept by id.
-  bodies_.init(cfg_.rigid_bodies, p_.x, p_.kind, p_.id, static_cast<double>(reference_sound_speed(cfg_)));
+  return rho_in;
+}
 
+// Each particle checked against the phase and kind tables, and given its phase's rest density, colour,
+// viscosity and (fluid without one) mass.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::set_phase_values(const std::vector<Real>& rho_in) {
+  const std::size_t n = p_.x.size();
   fluid_count_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const auto ph = p_.phase[i];
@@ -195,25 +204,33 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
       }
     }
   }
+}
+
+template <int Dim, class Real>
+Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
+    : cfg_(std::move(config)), p_(std::move(particles)), search_(step_search(cfg_.search)) {
+  cfg_.validate();
+  for (const auto& ph : cfg_.phases) phase_params_.push_back({ph.rest_density, ph.viscosity, ph.sigma});
+  const std::size_t n = p_.x.size();
+  const std::vector<Real> rho_in = complete_fields();
+  rho0_.assign(n, Real(0));
+  state_.assign_zero(n);
+  inflow_.init(cfg_, n);
+  // Moving walls: each particle's motion and initial position, kept by id (the input order's index is
+  // lost when the boundary is reordered below).
+  moving_.init(cfg_.wall_motion, p_.x, p_.kind, p_.id, kBoundary);
+  // Floating bodies: each body particle's offset from its body's centre, kept by id.
+  bodies_.init(cfg_.rigid_bodies, p_.x, p_.kind, p_.id, static_cast<double>(reference_sound_speed(cfg_)));
+
+  set_phase_values(rho_in);
   for (const auto& ph : cfg_.phases) any_tension_ = any_tension_ || ph.sigma > 0;
   wall_states_ = cfg_.wall_model != WallModel::Akinci && fluid_count_ < n;
-  f_pressure_.assign(n, V{});
-  fluid_.clear();
-  fluid_.reserve(fluid_count_);
-  boundary_.clear();
+  stepper_ = make_model_stepper<Dim, Real, HostStepContext<Dim, Real>>(cfg_);
   // Default 0.15 h: 1.5x the pairs in the lists (3D), rebuilt every few steps at the dam break's speeds.
   skin_ = cfg_.verlet_skin * cfg_.support;
   search_h_.assign(n, Real(0));
   bare_h_.assign(n, Real(0));
-  for (std::size_t i = 0; i < n; ++i) {
-    if (p_.kind[i] != kFluid) {
-      boundary_.push_back(static_cast<std::uint32_t>(i));
-      continue;
-    }
-    fluid_.push_back(static_cast<std::uint32_t>(i));
-    bare_h_[i] = p_.h[i];
-    search_h_[i] = p_.h[i] + skin_;
-  }
+  rebuild_kind_lists();
   // Boundary particles never move: one reorder puts them in cell order for the whole run (before their
   // weights, whose sums then run in that order too).
   if (cfg_.reorder_every > 0) reorder_slots(boundary_);
@@ -243,8 +260,7 @@ void Simulation<Dim, Real>::set_body_slots(bool place) {
 // The bodies' fluid and contact loads (boundary/rigid_bodies.hpp) from their own rows and the force
 // pass's own wall term.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_body_loads() {
-  const ParticleView<Dim, Real> pv = view();
+void Simulation<Dim, Real>::compute_body_loads(const ParticleView<Dim, Real>& pv) {
   with_wcsph_forces_pass(cfg_, pv, any_tension_, wall_states_,
                          [&](const auto& pass) { bodies_.compute_loads(pv, pass); });
 }
@@ -278,29 +294,14 @@ void Simulation<Dim, Real>::restore_bodies(std::vector<RigidBodyState> states, c
 
 template <int Dim, class Real>
 void Simulation<Dim, Real>::set_moving_slots() {
-  moving_.clear();
-  moving_x0_.clear();
-  moving_motion_.clear();
-  if (!cfg_.wall_motion.any()) return;
-  for (const std::uint32_t b : boundary_) {
-    const std::int32_t m = motion_of_id_[p_.id[b]];
-    if (m < 0) continue;
-    moving_.push_back(b);
-    moving_x0_.push_back(x0_of_id_[p_.id[b]]);
-    moving_motion_.push_back(m);
-  }
-  wall_a_.assign(p_.size(), V{});
+  moving_.set_slots(p_.id, boundary_);
+  if (cfg_.wall_motion.any()) wall_a_.assign(p_.size(), V{});
 }
 
-// Moving walls at time t (boundary/wall_motion.hpp): positions, velocities and accelerations from the
-// initial positions; walls at rest keep v = 0.
+// Moving walls at time t (boundary/moving_walls.hpp); walls at rest keep v = 0.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::move_walls(Real t) {
-  if (moving_.empty()) return;
-  run_pass(moving_.size(), MovingWallPass<Dim, Real>{p_.x.data(), p_.v.data(), wall_a_.data(), moving_.data(),
-                                                     moving_x0_.data(), moving_motion_.data(),
-                                                     cfg_.wall_motion.motions.data(),
-                                                     cfg_.wall_motion.rows.data(), static_cast<double>(t)});
+  moving_.move(cfg_.wall_motion, static_cast<double>(t), p_.x.data(), p_.v.data(), wall_a_.data());
 }
 
 template <int Dim, class Real>
@@ -312,24 +313,10 @@ ParticleView<Dim, Real> Simulation<Dim, Real>::view() {
   v.vol = vol_.data();
   v.prho2 = prho2_.data();
   v.normal = normal_.data();
-  v.f_pressure = f_pressure_.data();
   v.wall_v = wall_v_.data();
   v.wall_a = wall_a_.empty() ? nullptr : wall_a_.data();
   v.wall_self_rho = wall_self_rho_.data();
-  v.drho = drho_.data();
-  v.df_alpha = df_alpha_.data();
-  v.df_kappa = df_kappa_.data();
   v.df_kappa_v = state_.dfsph_kappa_v.data();
-  v.df_grad = df_grad_.data();
-  v.df_gsum = df_gsum_.data();
-  v.df_gwall = df_gwall_.data();
-  v.df_mv = df_mv_.data();
-  v.df_mk = df_mk_.data();
-  v.cg_v0 = cg_v0_.data();
-  v.cg_s = cg_s_.data();
-  v.cg_p = cg_p_.data();
-  v.cg_ap = cg_ap_.data();
-  v.cg_active = cg_active_.data();
   v.offsets = nl_.offsets.data();
   v.candidates = nl_.indices.data();
   v.within = rows_at_h_ ? nl_.indices.data() : within_.data();
@@ -352,54 +339,21 @@ void Simulation<Dim, Real>::init_boundary_weights() {
   dynamic_wall_self_density(cfg_, view());
 }
 
-// Cells of size h counted from the lowest corner of these particles, keyed in Z-order; equal keys by id.
-// The order is a function of positions and ids alone (a total order, so any sort gives it), which
-// keeps results independent of the neighbour method, the skin and the thread count. Particles move
-// only among `slots`, so every slot keeps its kind.
+// The particles of `slots` into cell order (cell_order.hpp), with every array that persists between steps
+// (the others are rebuilt before they are read).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::reorder_slots(const IndexList& slots) {
-  const std::size_t m = slots.size();
-  if (m < 2) return;
-  V lo = p_.x[slots[0]];
-  for (const std::uint32_t i : slots)
-    for (int a = 0; a < Dim; ++a) lo[a] = std::min(lo[a], p_.x[i][a]);
-  const Real inv = Real(1) / cfg_.support;
-  constexpr std::uint64_t cmax = (std::uint64_t{1} << (64 / Dim)) - 1;
-  struct Item {
-    std::uint64_t key;
-    std::uint32_t id, slot;
-  };
-  std::vector<Item> items(m);
-  parallel_for(m, [&](std::size_t k) {
-    const std::uint32_t i = slots[k];
-    std::uint64_t c[Dim];
-    for (int a = 0; a < Dim; ++a) {
-      // Finite positions (check_state) at or above lo; far cells are clamped (only the order suffers).
-      const Real q = std::min(std::floor((p_.x[i][a] - lo[a]) * inv), static_cast<Real>(cmax));
-      c[a] = std::min(static_cast<std::uint64_t>(q), cmax);
-    }
-    items[k] = {morton_key<Dim>(c), p_.id[i], i};
-  });
-  std::sort(items.begin(), items.end(),
-            [](const Item& a, const Item& b) { return a.key != b.key ? a.key < b.key : a.id < b.id; });
-  // Slot slots[k] receives the particle from slot items[k].slot.
-  auto permute = [&](auto& field) {
-    if (field.size() != p_.size()) return;  // a scratch array not in use
-    using T = typename std::remove_reference_t<decltype(field)>::value_type;
-    std::vector<T> tmp(m);
-    parallel_for(m, [&](std::size_t k) { tmp[k] = field[items[k].slot]; });
-    parallel_for(m, [&](std::size_t k) { field[slots[k]] = tmp[k]; });
-  };
+  if (slots.size() < 2) return;
+  const std::vector<std::uint32_t> from = cell_order(p_.x, p_.id, slots, cfg_.support);
+  const std::size_t n = p_.size();
+  auto permute = [&](auto& field) { permute_slots(field, slots, from, n); };
   p_.for_each_field([&](std::string_view, auto& field) { permute(field); });
-  // Every member array that persists between steps (the others are rebuilt before they are read).
+  state_.for_each_field([&](std::string_view, auto& field) { permute(field); });
   permute(rho0_);
   permute(search_h_);
   permute(bare_h_);
   permute(vol_);
   permute(prho2_);
-  permute(f_pressure_);
-  permute(normal_);
-  state_.for_each_field([&](std::string_view, auto& field) { permute(field); });
   lists_valid_ = false;  // x_built_ and the lists name the old slots
 }
 
@@ -419,7 +373,7 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     // Moving walls count too: a pair's distance changes by at most the sum of both displacements.
     const MaxDisplacementPass<Dim, Real> disp{view(), x_built_.data()};
     Real d2 = reduce_max(fluid_, MaxValue<Real>{}, disp).value;
-    if (!moving_.empty()) d2 = std::max(d2, reduce_max(moving_, MaxValue<Real>{}, disp).value);
+    if (moving_.any()) d2 = std::max(d2, reduce_max(moving_.slots(), MaxValue<Real>{}, disp).value);
     if (bodies_.any()) d2 = std::max(d2, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
     if (d2 <= limit * limit) {
@@ -461,85 +415,54 @@ void Simulation<Dim, Real>::filter_lists(const IndexList& set) {
   run_pass(set, FilterRowsPass<Dim, Real>{view(), within_.data()});
 }
 
-// Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state
-// (models/summation_density.hpp).
+// Paper eq. 7 (or the number density of Solenthaler & Pajarola 2008), then the equation of state, or
+// the continuity density's pressure (models/density_pressure.hpp), for per-particle steps' work sets.
 template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_density_pressure(const IndexList& set) {
   timings_.density_evals += set.size();
   vol_.resize(p_.size());
   prho2_.resize(p_.size());
-  if (cfg_.density_evolution == DensityEvolution::Continuity)
-    continuity_state(cfg_, view(), set);  // models/continuity_density.hpp
-  else
-    summation_density(cfg_, view(), set);
+  fluid_density_pressure(cfg_, view(), set);
 }
 
-// Adami or dynamic walls: each wall particle's pressure, density (and no-slip velocity) from its fluid
-// neighbours, after the density pass (boundary/adami2012.hpp, boundary/dynamic_crespo2007.hpp).
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_wall_states() {
-  if (boundary_.empty()) return;
+void Simulation<Dim, Real>::prepare_shared_arrays() {
+  vol_.resize(p_.size());
+  prho2_.resize(p_.size());
+  if (!wall_states_ || boundary_.empty()) return;
   wall_v_.resize(p_.size());
   gather_wall_neighbors(view(), fluid_, boundary_, walls_);
-  if (cfg_.wall_model == WallModel::Dynamic)
-    dynamic_wall_states(cfg_, view(), boundary_);
-  else
-    adami2012_wall_states(cfg_, view(), boundary_);
 }
 
-// CSF (or Akinci 2013) colour normals of `set` (models/paper_multiphase.hpp).
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_normals(const IndexList& set) {
-  timings_.normal_evals += set.size();
-  normal_.assign(p_.size(), V{});
-  paper_normals(cfg_, view(), set);
+const BalancedIndexSet& Simulation<Dim, Real>::fluid_by_pairs() {
+  balance(
+      fluid_, static_cast<std::size_t>(max_threads()),
+      [&](std::uint32_t i) { return std::uint64_t{within_count_[i]} + kBalanceParticleWeight; },
+      fluid_split_);
+  return fluid_split_;
 }
 
-// Algorithm 1, lines 2-15 (models/paper_multiphase.hpp).
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_forces_paper(const IndexList& set, const IndexList& normal_set) {
-  timings_.force_evals += set.size();
-  const auto tension = PaperTension::of(cfg_, any_tension_);
-  if (tension.needs_normals()) compute_normals(normal_set);
-  paper_forces(cfg_, view(), set, tension, wall_states_);
+const DfsphStats* Simulation<Dim, Real>::solver_stats() const {
+  return device_ ? device_->solver_stats() : stepper_->solver_stats();
 }
 
-// The write-up's forces (models/wcsph.hpp).
 template <int Dim, class Real>
-void Simulation<Dim, Real>::compute_forces_wcsph() {
-  timings_.force_evals += fluid_.size();
-  wcsph_forces(cfg_, view(), fluid_, any_tension_, wall_states_);
+const DfsphStats& Simulation<Dim, Real>::dfsph_stats() const {
+  static const DfsphStats none{};
+  const DfsphStats* s = solver_stats();
+  return s ? *s : none;
 }
 
-// Fixed, or the global Courant step (timestep/global_courant.hpp).
 template <int Dim, class Real>
-Real Simulation<Dim, Real>::choose_dt() {
-  return global_courant_dt(cfg_, view(), fluid_);
+std::string Simulation<Dim, Real>::solver_progress() const {
+  return stepper_->progress(dfsph_stats(), clock_.last_dt);
 }
 
-// Leap-frog (eq. 11, models/paper_multiphase.hpp). On the first step v(t0) becomes v(t0 + dt/2); with a
-// changing step the kick uses the mean of the old and new step.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::integrate_paper(Real dt) {
-  const Real kick = leapfrog_started_ ? (last_dt_ + dt) / 2 : dt / 2;
-  run_pass(fluid_, PaperLeapFrogPass<Dim, Real>{view(), kick, dt});
-  leapfrog_started_ = true;
-}
-
-// The write-up's split with symplectic Euler (models/wcsph.hpp).
-template <int Dim, class Real>
-void Simulation<Dim, Real>::integrate_wcsph(Real dt) {
-  if (cfg_.density_evolution == DensityEvolution::Summation) {
-    run_pass(fluid_, WcsphSymplecticEulerPass<Dim, Real>{view(), dt});
-    return;
-  }
-  // Continuity density: the kick, then d rho / dt with the new velocities at the old positions (the rows
-  // of this step), rho += dt d rho / dt, then the drift (models/continuity_density.hpp).
-  run_pass(fluid_, WcsphKickPass<Dim, Real>{view(), dt});
-  drho_.resize(p_.size());
-  continuity_rate(cfg_, view(), fluid_);
-  run_pass(fluid_, ContinuityIntegratePass<Dim, Real>{view(), dt});
-  run_pass(fluid_, WcsphDriftPass<Dim, Real>{view(), dt});
+std::vector<std::string> Simulation<Dim, Real>::solver_summary() const {
+  return stepper_->summary(dfsph_stats(), timings_.neighbors);
 }
 
 // The box and the planes (integration/collisions.hpp).
@@ -664,18 +587,21 @@ void Simulation<Dim, Real>::step_per_particle() {
   build_work_sets(view(), fluid_, due_list_, normals, full_passes_, mark_, normal_set_, rho_set_);
   filter_lists(rho_set_);  // every pass below reads rows of rho_set_ only (it holds the other sets)
   compute_density_pressure(rho_set_);
-  compute_forces_paper(due_list_, normal_set_);
+  const auto tension = PaperTension::of(cfg_, any_tension_);
+  timings_.force_evals += due_list_.size();
+  if (tension.needs_normals()) timings_.normal_evals += normal_set_.size();
+  paper_normals_and_forces(cfg_, view(), due_list_, normal_set_, normal_, tension, wall_states_);
   std::swap(p_.x, xs_);
   timings_.forces += sw.ms();
 
   sw.reset();
-  per_particle_levels(cfg_, view(), due_list_, T, leapfrog_started_);
-  leapfrog_started_ = true;
+  per_particle_levels(cfg_, view(), due_list_, T, clock_.started);
+  clock_.started = true;
   apply_walls();
   check_state();
   std::int64_t next = earliest_tick(view(), fluid_);
   if (next == std::numeric_limits<std::int64_t>::max()) next = T + (std::int64_t{1} << L);
-  last_dt_ = static_cast<Real>(next - T) * unit;
+  clock_.last_dt = static_cast<Real>(next - T) * unit;
   time_ = static_cast<Real>(next) * unit;
   ++steps_;
   timings_.integration += sw.ms();
@@ -699,88 +625,28 @@ void Simulation<Dim, Real>::step() {
     timings_.reorder += sw.ms();
     sw.reset();
   }
-  inflow_mark();
+  inflow_.mark(cfg_.inflow, double(time_), fluid_, p_.x);
   compute_neighbors();
   timings_.neighbors += sw.ms();
 
   sw.reset();
   filter_lists(fluid_);
-  if (implicit_pressure(cfg_.model)) {
-    step_dfsph(sw);
-    return;
-  }
-  compute_density_pressure(fluid_);
-  if (wall_states_) compute_wall_states();
-  if (cfg_.model == Model::PaperMultiphase)
-    compute_forces_paper(fluid_, fluid_);
-  else
-    compute_forces_wcsph();
-  if (bodies_.any()) compute_body_loads();
-  timings_.forces += sw.ms();
-
-  sw.reset();
-  const Real dt = choose_dt();
-  if (cfg_.model == Model::PaperMultiphase)
-    integrate_paper(dt);
-  else
-    integrate_wcsph(dt);
-  inflow_hold(dt);
-  apply_walls();
-  check_state();
-  time_ += dt;
-  last_dt_ = dt;
-  ++steps_;
-  move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
-  if (bodies_.any()) advance_bodies(dt);
-  inflow_end_step(dt, true);
-  timings_.integration += sw.ms();
-}
-
-// The rest of a DFSPH step after the rows (models/dfsph.hpp), then the walls and the check.
-template <int Dim, class Real>
-void Simulation<Dim, Real>::step_dfsph(Stopwatch& sw) {
-  const std::size_t n = p_.size();
-  timings_.density_evals += fluid_.size();
-  timings_.force_evals += fluid_.size();
-  vol_.resize(n);
-  prho2_.resize(n);
-  df_alpha_.resize(n);
-  df_kappa_.resize(n);
-  df_grad_.resize(nl_.indices.size());
-  df_gsum_.resize(n);
-  df_gwall_.resize(n);
-  df_mv_.resize(n);
-  df_mk_.resize(n);
-  if (cfg_.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient) {
-    cg_v0_.resize(n);
-    cg_s_.resize(n);
-    cg_p_.resize(n);
-    cg_ap_.resize(n);
-    cg_active_.resize(n);
-  }
-  if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);
-  // The threads split the fluid by pairs, not by particles (pass_driver.hpp): the same bits either way.
-  balance(
-      fluid_, static_cast<std::size_t>(max_threads()),
-      [&](std::uint32_t i) { return std::uint64_t{within_count_[i]} + kBalanceParticleWeight; },
-      fluid_split_);
+  prepare_shared_arrays();
+  HostStepContext<Dim, Real> ctx(*this, sw);
   Real dt = 0;
   try {
-    dt = cfg_.model == Model::Iisph
-             ? iisph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1)
-             : dfsph_step(cfg_, view(), fluid_split_, n, df_diameter_, dfsph_stats_, steps_ + 1);
+    dt = stepper_->advance(ctx);  // to the drift; the stepper ends the force phase's timing
   } catch (const SimulationError& e) {
     report_diverged_solve(e);
   }
-  timings_.forces += sw.ms();
-  sw.reset();
-  inflow_hold(dt);
+  inflow_.hold(fluid_, p_.x.data(), p_.v.data(), dt);
   apply_walls();
   check_state();
   time_ += dt;
-  last_dt_ = dt;
+  clock_.last_dt = dt;
   ++steps_;
   move_walls(time_);  // the walls where the next step's forces see them (and outputs, checkpoints)
+  if (bodies_.any()) advance_bodies(dt);
   inflow_end_step(dt, true);
   timings_.integration += sw.ms();
 }
@@ -801,90 +667,21 @@ void Simulation<Dim, Real>::rebuild_kind_lists() {
   lists_valid_ = false;
 }
 
-// Which emitters are active at the step's start (active_); true when one is.
-template <int Dim, class Real>
-bool Simulation<Dim, Real>::inflow_activity() {
-  active_.assign(frames_.size(), 0);
-  bool any = false;
-  for (std::size_t e = 0; e < frames_.size(); ++e) {
-    active_[e] = emitter_active(cfg_.inflow.emitters[e], double(time_)) ? 1 : 0;
-    any = any || active_[e];
-  }
-  return any;
-}
-
-// The fluid particles in the buffer of an emitter active at the step's start (emitters.hpp), with their
-// positions at that time.
-template <int Dim, class Real>
-void Simulation<Dim, Real>::inflow_mark() {
-  holding_ = inflow_activity();
-  if (!holding_) return;
-  held_of_.resize(p_.size());
-  held_x_.resize(p_.size());
-  run_pass(fluid_, InflowMarkPass<Dim, Real>{p_.x.data(), held_of_.data(), held_x_.data(),
-                                             emitter_planes_.data(), active_.data(), frames_.size()});
-}
-
-template <int Dim, class Real>
-void Simulation<Dim, Real>::inflow_hold(Real dt) {
-  if (!holding_) return;
-  run_pass(fluid_, InflowHoldPass<Dim, Real>{p_.x.data(), p_.v.data(), held_of_.data(), held_x_.data(),
-                                             emitter_planes_.data(), dt});
-}
-
-// After the step: the sinks' particles are removed, then the layers due are appended (oldest first, emitter
-// by emitter), with new ids. An emitted particle is fluid of the emitter's phase at rest density and zero
-// pressure, moving at U along the normal (the paper model's half-step velocity too), with zero solver state.
+// After the step: the sinks' particles are removed, then the layers due are appended (inflow_outflow.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::inflow_end_step(Real dt, bool maybe_in_sink) {
   if (!cfg_.inflow.any()) return;
   std::vector<V> xs;
   std::vector<std::int32_t> emitter_of;
-  for (std::size_t e = 0; e < frames_.size(); ++e) {
-    if (!active_[e]) continue;  // active at the step's start (inflow_activity)
-    // The buffer moves U dt a step: more than a few spacings means a fixed step far too long for the inflow
-    // (the Courant step keeps it below one), and a runaway count; stop with the numbers.
-    const double travel = cfg_.inflow.emitters[e].velocity * double(dt);
-    if (travel > 4 * cfg_.inflow.spacing)
-      throw SimulationError("emitters[" + std::to_string(e) + "]: velocity * dt = " + std::to_string(travel) +
-                            " m in one step, more than 4 particle spacings (" +
-                            std::to_string(cfg_.inflow.spacing) + " m): shorten the time step");
-    emit_layers(frames_[e], cfg_.inflow.emitters[e].velocity, double(dt), advance_[e], xs);
-    emitter_of.resize(xs.size(), static_cast<std::int32_t>(e));
-  }
+  inflow_.due_layers(cfg_.inflow, dt, xs, emitter_of);
   if (xs.empty() && !maybe_in_sink) return;
   // A device backend: the count changes here, on the host, from the device's particles (put back below).
   sync_host();
-  const std::size_t n = p_.size();
-  std::vector<std::uint8_t> keep;
-  if (!cfg_.inflow.sinks.empty()) {
-    keep.assign(n, 1);
-    run_pass(fluid_, InflowSinkPass<Dim, Real>{
-                         {p_.x.data(), cfg_.inflow.sinks.data(), cfg_.inflow.sinks.size()}, keep.data()});
-    if (std::find(keep.begin(), keep.end(), std::uint8_t{0}) == keep.end()) keep.clear();
-  }
+  const std::vector<std::uint8_t> keep = inflow_.sink_keep(cfg_.inflow, fluid_, p_.x);
   if (keep.empty() && xs.empty()) return;
-  if (next_id_ + xs.size() > std::uint64_t{std::numeric_limits<std::uint32_t>::max()} + 1)
-    throw SimulationError("emitters: the 2^32 particle ids are used up at t = " + std::to_string(time_) +
-                          " s");
+  inflow_.check_ids(xs.size(), time_);
   change_count(keep, xs.size());
-  const std::size_t first = p_.size() - xs.size();
-  for (std::size_t k = 0; k < xs.size(); ++k) {
-    const std::size_t i = first + k;
-    const auto& frame = frames_[static_cast<std::size_t>(emitter_of[k])];
-    const std::int32_t ph = cfg_.inflow.emitters[static_cast<std::size_t>(emitter_of[k])].phase;
-    const auto& phase = cfg_.phases[static_cast<std::size_t>(ph)];
-    p_.x[i] = xs[k];
-    p_.v[i] = frame.velocity;
-    p_.m[i] = phase.mass;
-    p_.rho[i] = phase.rest_density;
-    p_.h[i] = cfg_.support;
-    p_.color[i] = phase.color;
-    p_.mu[i] = phase.viscosity;
-    p_.phase[i] = ph;
-    p_.kind[i] = kFluid;
-    p_.id[i] = static_cast<std::uint32_t>(next_id_++);
-  }
+  inflow_.fill_emitted(cfg_, p_, p_.size() - xs.size(), xs, emitter_of);
   rebuild_kind_lists();
   set_moving_slots();
   move_walls(time_);
@@ -915,14 +712,10 @@ void Simulation<Dim, Real>::change_count(const std::vector<std::uint8_t>& keep, 
   edit(bare_h_);
   edit(vol_);
   edit(prho2_);
-  edit(f_pressure_);
   edit(normal_);
   edit(wall_v_);
   edit(wall_self_rho_);
   edit(wall_a_);
-  edit(drho_);
-  edit(df_alpha_);
-  edit(df_kappa_);
   edit(within_count_);
   lists_valid_ = false;
 }
@@ -959,9 +752,12 @@ Real Simulation<Dim, Real>::total_mass() const {
   return s;
 }
 
+// A checkpoint's count and ids against this simulation (InputError prefixed with `source`). Returns the
+// next id its emitters continue from.
 template <int Dim, class Real>
-void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state,
-                                    const std::string& source, SolverState<Dim, Real> solver) {
+std::uint64_t Simulation<Dim, Real>::check_restored_ids(const Particles<Dim, Real>& particles,
+                                                        const IntegratorState<Real>& state,
+                                                        const std::string& source) const {
   const std::size_t n = particles.size();
   const bool inflow = cfg_.inflow.any();
   if (n != p_.size() && !inflow) {
@@ -986,15 +782,26 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
     if (next_id < above)
       throw InputError(source + ": particle id " + std::to_string(ids.back()) + " is not below the next id " +
                        std::to_string(next_id));
-    if (!state.emitter_advance.empty() && state.emitter_advance.size() != frames_.size())
+    if (!state.emitter_advance.empty() && state.emitter_advance.size() != inflow_.emitters())
       throw InputError(source + ": holds the state of " + std::to_string(state.emitter_advance.size()) +
-                       " emitters, the scene has " + std::to_string(frames_.size()));
+                       " emitters, the scene has " + std::to_string(inflow_.emitters()));
     for (const double a : state.emitter_advance)
       if (!(a >= 0 && a < 2 * cfg_.inflow.spacing))
         throw InputError(source + ": emitter advance " + std::to_string(a) + " is outside [0, 2 spacings)");
   } else if (const auto err = id_permutation_error(particles.id); !err.empty()) {
     throw InputError(source + ": " + err);
   }
+  return next_id;
+}
+
+// Values no run holds in a checkpoint's particles, solver state (completed with 0 where empty) and clock
+// (InputError prefixed with `source`).
+template <int Dim, class Real>
+void Simulation<Dim, Real>::check_restored_values(const Particles<Dim, Real>& particles,
+                                                  SolverState<Dim, Real>& solver,
+                                                  const IntegratorState<Real>& state,
+                                                  const std::string& source) const {
+  const std::size_t n = particles.size();
   for (std::size_t i = 0; i < n; ++i) {
     if (particles.phase[i] < 0 || static_cast<std::size_t>(particles.phase[i]) >= cfg_.phases.size() ||
         particles.kind[i] > kBoundary) {
@@ -1063,21 +870,22 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
     throw InputError(source + ": fluid particles' ticks span " + std::to_string(lo_tick) + ".." +
                      std::to_string(hi_tick) + ", more than 2^" + std::to_string(cfg_.time.max_level) +
                      " (one largest step)");
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const IntegratorState<Real>& state,
+                                    const std::string& source, SolverState<Dim, Real> solver) {
+  const std::size_t n = particles.size();
+  const bool inflow = cfg_.inflow.any();
+  const std::uint64_t next_id = check_restored_ids(particles, state, source);
+  check_restored_values(particles, solver, state, source);
   p_ = std::move(particles);
-  // Scratch arrays hold nothing across steps: with another count they start afresh at the new size.
-  if (f_pressure_.size() != n) f_pressure_.assign(n, V{});
   rho0_.resize(n);
   search_h_.resize(n);
   bare_h_.resize(n);
   rebuild_kind_lists();
   state_ = std::move(solver);
-  if (inflow) {
-    next_id_ = next_id;
-    if (!state.emitter_advance.empty())
-      advance_ = state.emitter_advance;
-    else
-      advance_.assign(frames_.size(), cfg_.inflow.spacing);
-  }
+  if (inflow) inflow_.restore(next_id, state.emitter_advance, cfg_.inflow.spacing);
   // Dynamic walls: their fixed density share, from the restored walls (kept weights, no reorder). Its
   // neighbour search is the first to see the positions: one beyond what a search can index (1e86 m) is
   // the file's fault, named as such (the Simulation is then not usable; the caller stops).
@@ -1085,7 +893,7 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
   set_body_slots(false);  // their particles are the checkpoint's; restore_bodies sets their states
   if (cfg_.wall_model == WallModel::Dynamic) {
     // Moving walls: the fixed share is that of the initial positions, as at construction.
-    for (std::size_t k = 0; k < moving_.size(); ++k) p_.x[moving_[k]] = moving_x0_[k];
+    moving_.to_initial(p_.x.data());
     try {
       init_boundary_weights();
     } catch (const CapacityError& e) {
@@ -1093,9 +901,9 @@ void Simulation<Dim, Real>::restore(Particles<Dim, Real> particles, const Integr
     }
   }
   time_ = state.time;
-  last_dt_ = state.last_dt;
+  clock_.last_dt = state.last_dt;
   steps_ = state.steps;
-  leapfrog_started_ = state.leapfrog_started;
+  clock_.started = state.leapfrog_started;
   move_walls(time_);
   if (device_) {
     upload_to_device();
@@ -1109,6 +917,7 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
   if (b == Backend::Cpu) {
     sync_host();
     move_walls(time_);  // their accelerations (wall_a_, not a particle field) at the device's clock
+    if (DfsphStats* s = stepper_->solver_stats()) *s = *device_->solver_stats();
     device_.reset();
     backend_ = b;
     lists_valid_ = false;
@@ -1119,6 +928,8 @@ void Simulation<Dim, Real>::use_backend(Backend b) {
     throw InputError("solver.backend " + std::string(backend_name(b)) + ": " + why);
   sync_host();
   device_ = b == Backend::Cuda ? make_cuda_stepper(cfg_) : make_host_device_stepper(cfg_);
+  if (const DfsphStats* s = stepper_->solver_stats())
+    *device_->solver_stats() = *s;  // the run's counts go on
   upload_to_device();
   backend_ = b;
 }
@@ -1129,8 +940,8 @@ void Simulation<Dim, Real>::upload_to_device() {
   device_->upload(p_);
   if (cfg_.wall_model == WallModel::Dynamic && !boundary_.empty())
     device_->upload_wall_self_density(wall_self_rho_);
-  if (!moving_.empty() || !wall_a_.empty())
-    device_->upload_wall_motion(moving_, moving_x0_, moving_motion_, wall_a_);
+  if (moving_.any() || !wall_a_.empty())
+    device_->upload_wall_motion(moving_.slots(), moving_.initial_positions(), moving_.motions(), wall_a_);
   if (bodies_.any()) device_->upload_bodies(bodies_);
   if (implicit_pressure(cfg_.model)) device_->upload_solver_state(state_);
 }
@@ -1149,14 +960,8 @@ void Simulation<Dim, Real>::step_device() {
     ++timings_.reorders;
     timings_.reorder += sw.ms();
   }
-  DeviceStepInput<Real> in{time_, last_dt_, leapfrog_started_};
-  if (inflow_activity()) in.emitters_active = active_.data();
-  if (implicit_pressure(cfg_.model)) {
-    if (df_diameter_ == 0) df_diameter_ = dfsph_particle_diameter(view(), fluid_);  // m, rho0: on the host
-    in.step = steps_ + 1;
-    in.dfsph_diameter = df_diameter_;
-    in.dfsph = &dfsph_stats_;
-  }
+  DeviceStepInput<Real> in{time_, clock_, steps_ + 1};
+  if (inflow_.activity(cfg_.inflow, double(time_))) in.emitters_active = inflow_.active_flags();
   DeviceStepResult<Real> r{};
   try {
     r = device_->step(in);
@@ -1164,7 +969,7 @@ void Simulation<Dim, Real>::step_device() {
     host_stale_ = true;  // the device's particles, as the diverged solve left them
     report_diverged_solve(e);
   }
-  if (cfg_.model == Model::PaperMultiphase) leapfrog_started_ = true;
+  clock_.started = r.leapfrog_started;
   host_stale_ = true;
   timings_.neighbors += r.neighbors_ms;
   timings_.forces += r.forces_ms;
@@ -1174,7 +979,7 @@ void Simulation<Dim, Real>::step_device() {
   timings_.force_evals += fluid_count_;
   if (r.first_bad >= 0) report_unstable(r.first_bad);  // copies the particles back to describe it
   time_ += r.dt;
-  last_dt_ = r.dt;
+  clock_.last_dt = r.dt;
   ++steps_;
   if (bodies_.any()) {
     // The loads from the device's per-particle forces, summed here in the CPU's order; the rigid step

@@ -1,11 +1,14 @@
 #pragma once
-// The SPH solver: one object owns the particles, the configuration and the neighbour search, and advances
-// them by step(). Three models (config.model):
+// The SPH solver: one object owns the particles, the configuration, the neighbour search and the
+// components (moving walls, floating bodies, emitters and sinks, the reorder into cell order), and advances
+// them by step(), which calls the model's stepper (models/model_stepper.hpp, chosen once by
+// models/model_registry.hpp) between what every model shares. Four models (config.model):
 //  * PaperMultiphase: Onderik & Durikovic 2007, Algorithm 1 (density eq. 7, Tait, averaged forces eq. 8a-b,
-//    colour field and interface tension eq. 8c/9, leap-frog eq. 11).
-//  * Wcsph: the CUDA write-up's weakly compressible SPH with operator splitting and symplectic Euler.
-//  * Dfsph: Bender & Koschier's divergence-free SPH, pressure solved implicitly (models/dfsph.hpp).
-//  * Iisph: Ihmsen et al.'s implicit incompressible SPH on DFSPH's passes (models/iisph.hpp).
+//    colour field and interface tension eq. 8c/9, leap-frog eq. 11): models/paper_stepper.hpp.
+//  * Wcsph: the CUDA write-up's weakly compressible SPH with operator splitting and symplectic Euler
+//    (models/wcsph_stepper.hpp).
+//  * Dfsph: Bender & Koschier's divergence-free SPH, pressure solved implicitly (models/dfsph_stepper.hpp).
+//  * Iisph: Ihmsen et al.'s implicit incompressible SPH on DFSPH's passes (models/iisph_stepper.hpp).
 //
 // Velocities: in the paper's model particles().v holds the leap-frog half-step velocity v(t - dt/2) once
 // the first step has run (eq. 11); in the WCSPH model it is v(t).
@@ -33,12 +36,14 @@
 #include "cellsph/core/vec.hpp"
 #include "cellsph/neighbors/neighbor_search.hpp"
 #include "cellsph/solver/backend.hpp"
+#include "cellsph/solver/boundary/moving_walls.hpp"
 #include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_stepper_base.hpp"
-#include "cellsph/solver/emitters.hpp"
+#include "cellsph/solver/inflow_outflow.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
+#include "cellsph/solver/models/model_stepper.hpp"
 #include "cellsph/solver/particle_view.hpp"
 #include "cellsph/solver/particles.hpp"
 #include "cellsph/solver/pass_driver.hpp"
@@ -75,6 +80,9 @@ struct IntegratorState {
 };
 
 template <int Dim, class Real>
+class HostStepContext;  // simulation.cpp: what a model's stepper sees of the CPU backend
+
+template <int Dim, class Real>
 class Simulation {
  public:
   using V = Vec<Dim, Real>;
@@ -99,7 +107,7 @@ class Simulation {
 
   [[nodiscard]] Real time() const { return time_; }
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
-  [[nodiscard]] Real last_dt() const { return last_dt_; }
+  [[nodiscard]] Real last_dt() const { return clock_.last_dt; }
   // In the internal (cell) order: see "Particle order" above; particles().id names each particle.
   // With a device backend the particles are copied back here, only when the device holds newer ones
   // (at output and checkpoint times).
@@ -112,8 +120,14 @@ class Simulation {
   [[nodiscard]] const SearchStats& search_stats() const { return search_.stats(); }
   [[nodiscard]] std::size_t fluid_count() const { return fluid_count_; }
   // Model::Dfsph and Model::Iisph: iterations and errors of the pressure solves (models/dfsph.hpp,
-  // iisph.hpp).
-  [[nodiscard]] const DfsphStats& dfsph_stats() const { return dfsph_stats_; }
+  // iisph.hpp); all 0 for the explicit models.
+  [[nodiscard]] const DfsphStats& dfsph_stats() const;
+  // The same, null for the explicit models.
+  [[nodiscard]] const DfsphStats* solver_stats() const;
+  // What the model's stepper shows of the run (models/model_stepper.hpp): its part of the progress line
+  // ("" for none) and its summary lines (the implicit solves' sweeps, errors and where a step's time goes).
+  [[nodiscard]] std::string solver_progress() const;
+  [[nodiscard]] std::vector<std::string> solver_summary() const;
 
   // Diagnostics over fluid particles.
   [[nodiscard]] V momentum() const;
@@ -128,7 +142,7 @@ class Simulation {
     return state_;
   }
   [[nodiscard]] IntegratorState<Real> integrator_state() const {
-    return {time_, last_dt_, steps_, leapfrog_started_, next_id_, advance_};
+    return {time_, clock_.last_dt, steps_, clock_.started, inflow_.next_id(), inflow_.advance()};
   }
   // Replaces the particles and the integrator state. Throws InputError, prefixed with `source` (the
   // checkpoint file), when the particles do not fit this simulation: count (any count with emitters or
@@ -153,9 +167,9 @@ class Simulation {
   void restore_bodies(std::vector<RigidBodyState> states, const std::string& source);
 
   // Per-particle steps, for tests and benchmarks: true computes the densities (and CSF normals) of every
-  // fluid particle in every sub-step, as before the work sets existed. Results are bit-identical either
-  // way (only the densities of particles no force reads differ: with the work sets they keep the value
-  // of their last evaluation); only the cost changes.
+  // fluid particle in every sub-step instead of only those the due particles' forces read. Results are
+  // bit-identical either way (only the densities of particles no force reads differ: with the work sets they
+  // keep the value of their last evaluation); only the cost changes.
   void set_full_passes(bool on) { full_passes_ = on; }
 
   // The backend of the following steps (backend.hpp). Cpu (the default) steps here; Cuda and HostDevice
@@ -168,6 +182,17 @@ class Simulation {
   [[nodiscard]] Backend backend() const { return backend_; }
 
  private:
+  friend class HostStepContext<Dim, Real>;
+  // Construction's parts: the particles' fields completed (returns the input densities a continuity run
+  // starts from), then checked against the phase and kind tables and given their phases' values.
+  std::vector<Real> complete_fields();
+  void set_phase_values(const std::vector<Real>& rho_in);
+  // restore()'s checks of a checkpoint (InputError prefixed with `source`): its count and ids (returns
+  // the next id of its emitters), then the values no run holds.
+  std::uint64_t check_restored_ids(const Particles<Dim, Real>& particles, const IntegratorState<Real>& state,
+                                   const std::string& source) const;
+  void check_restored_values(const Particles<Dim, Real>& particles, SolverState<Dim, Real>& solver,
+                             const IntegratorState<Real>& state, const std::string& source) const;
   // The plain view of every per-particle array the passes read (particle_view.hpp). Built afresh for each
   // pass: it holds the arrays' current addresses, which change when an array is resized or swapped.
   ParticleView<Dim, Real> view();
@@ -181,16 +206,14 @@ class Simulation {
   // The passes run over a set of fluid particles (ascending indices): fluid_ for a global step. Each runs
   // the pass of the file named in its definition through the driver (pass_driver.hpp).
   void compute_density_pressure(const IndexList& set);
-  // normal_set: the particles whose CSF normals the forces of `set` read.
-  void compute_forces_paper(const IndexList& set, const IndexList& normal_set);
-  void compute_normals(const IndexList& set);
-  void compute_forces_wcsph();
-  // Adami et al. 2012 and dynamic walls: pressure, density and no-slip velocity of every boundary
-  // particle from its fluid neighbours, after the density pass.
-  void compute_wall_states();
-  Real choose_dt();
-  void integrate_paper(Real dt);
-  void integrate_wcsph(Real dt);
+  // The per-particle arrays every model reads sized for this step, and with Adami or dynamic walls each
+  // wall particle's fluid neighbours gathered from the fluid rows (boundary/wall_neighbors.hpp), so
+  // that the view a stepper takes stays valid through the step.
+  void prepare_shared_arrays();
+  // The floating bodies' loads from the force pass's wall term (WCSPH).
+  void compute_body_loads(const ParticleView<Dim, Real>& pv);
+  // Host: the fluid split between the threads by row length, for the implicit solvers' sweeps.
+  const BalancedIndexSet& fluid_by_pairs();
   void apply_walls();
   void check_state();
   [[noreturn]] void report_unstable(std::int64_t first) const;
@@ -200,31 +223,23 @@ class Simulation {
   void upload_to_device();
   void sync_host() const;
   void init_boundary_weights();
-  // Moving walls (boundary/wall_motion.hpp): the slots of the moving wall particles with their initial
-  // positions and motions, from the particles' ids (set_moving_slots), and their state at time t
-  // (move_walls: position, velocity, acceleration; a pure function of t and the initial position).
+  // Moving walls (boundary/moving_walls.hpp): their slots from the particles' ids (set_moving_slots), and
+  // their state at time t (move_walls: position, velocity, acceleration).
   void set_moving_slots();
   void move_walls(Real t);
   // Floating bodies: their slots (from the ids) and their particles' search radius (the contact distance,
   // so that their rows hold the walls they touch).
   void set_body_slots(bool place);
-  // Their load from the step's forces, after the fluid's force pass; their step of dt (then their
-  // particles are placed; SimulationError when a state is not finite).
-  void compute_body_loads();
+  // Their step of dt (then their particles are placed; SimulationError when a state is not finite).
   void advance_bodies(Real dt);
   void step_per_particle();
-  void step_dfsph(Stopwatch& sw);
   // The particles of `slots` (ascending indices of one kind) reordered among those slots by cell key,
   // ties by id; every per-particle array is permuted and the Verlet lists invalidated.
   void reorder_slots(const IndexList& slots);
-  // Emitters and sinks (emitters.hpp): which emitters are active at the step's start (inflow_activity),
-  // mark the buffer's particles then, hold them after the integration, then emit layers and remove the
-  // sinks' particles at the end of the step. maybe_in_sink: false when the device found no fluid particle in
-  // a sink (the count then changes only when a layer is due; with a device backend a change copies the
-  // particles here and back).
-  bool inflow_activity();
-  void inflow_mark();
-  void inflow_hold(Real dt);
+  // Emitters and sinks (inflow_outflow.hpp) at the end of a step: the layers due emitted and the sinks'
+  // particles removed. maybe_in_sink: false when the device found no fluid particle in a sink (the count
+  // then changes only when a layer is due; with a device backend a change copies the particles here and
+  // back).
   void inflow_end_step(Real dt, bool maybe_in_sink);
   // Removes the particles with keep[i] == 0 (stable; keep empty: none) and appends `added` particles
   // (zero-filled, for the caller to set), in every per-particle array; rebuilds the kind lists.
@@ -241,12 +256,12 @@ class Simulation {
   NeighborList nl_;
   std::vector<std::uint32_t> within_;  // filter_lists: row i at nl_.offsets[i], within_count_[i] long
   std::vector<std::uint32_t> within_count_;
-  std::vector<V> normal_;      // CSF: colour gradient n_i of the current step
-  std::vector<V> f_pressure_;  // WCSPH: pressure force, applied after the predicted velocity
-  std::vector<Real> rho0_;     // rest density per particle (from its phase)
+  // The model's stepper (models/model_registry.hpp), which owns the arrays only its model reads.
+  std::unique_ptr<ModelStepper<Dim, Real, HostStepContext<Dim, Real>>> stepper_;
+  std::vector<V> normal_;                        // per-particle steps: the CSF colour normals of the sub-step
+  std::vector<Real> rho0_;                       // rest density per particle (from its phase)
   std::vector<PhaseParams<Real>> phase_params_;  // cfg_.phases as the passes read them
-  // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair
-  // (the same expressions as before, so the values are bit for bit those computed per pair).
+  // Per fluid particle, from the density pass, so pair loops divide once per particle, not per pair.
   std::vector<Real> vol_;    // V_j = m_j / rho_j
   std::vector<Real> prho2_;  // p_j / rho_j^2 (WCSPH symmetric pressure)
   std::vector<V> xs_;        // per-particle steps: every position extrapolated to the global clock
@@ -265,8 +280,6 @@ class Simulation {
   // WallModel::Dynamic: sum_c m_c W_wc over the wall particles c within h of wall w (w itself included),
   // the constant part of w's summation density (walls never move); 0 for fluid slots.
   std::vector<Real> wall_self_rho_;
-  // WCSPH continuity density: d rho / dt of the step (models/continuity_density.hpp); read within the step.
-  std::vector<Real> drho_;
   // Indices of the fluid particles, ascending. Kinds never change, and reordering permutes particles
   // only among the slots of their own kind, so this list is fixed for a simulation.
   std::vector<std::uint32_t> fluid_;
@@ -299,22 +312,14 @@ class Simulation {
 
   // Integrator state (integrator_state(), restore()).
   Real time_ = 0;
-  Real last_dt_ = 0;
+  LeapFrogClock<Real> clock_;  // the last step, and whether v holds v(t - dt/2) (the paper's leap-frog)
   std::uint64_t steps_ = 0;
-  bool leapfrog_started_ = false;  // v holds v(t - dt/2)
 
   StepTimings timings_;
 
-  // Moving walls (config wall_motion): per particle id, the initial position and the motion (-1: at
-  // rest), taken from the particles given at construction (the scene's, so a resume built from the same
-  // scene has them: nothing of this is in a checkpoint); per moving wall k, its slot, initial position
-  // and motion (boundary slots never change after construction; rebuilt from the ids on restore); each
-  // wall particle's acceleration (Adami's pressure reads it; empty when nothing moves).
-  std::vector<V> x0_of_id_;
-  std::vector<std::int32_t> motion_of_id_;
-  IndexList moving_;
-  std::vector<V> moving_x0_;
-  std::vector<std::int32_t> moving_motion_;
+  // Moving walls (config wall_motion, boundary/moving_walls.hpp), and each wall particle's acceleration
+  // (moving walls and floating bodies set it, Adami's pressure reads it; empty when nothing moves).
+  MovingWalls<Dim, Real> moving_;
   std::vector<V> wall_a_;
   // Floating bodies (config rigid_bodies): their particles' slots, offsets, states and loads; with a device
   // backend, per body particle the force and position the device computed in the step.
@@ -325,36 +330,15 @@ class Simulation {
   // State carried from step to step that is not a particle field (solver_state(); permuted by reorders,
   // in checkpoints): the DFSPH divergence solve's accumulated k, its next warm start.
   mutable SolverState<Dim, Real> state_;  // mutable: copied back from a device with the particles
-  // Model::Dfsph (models/dfsph.hpp): alpha and the sweep's k are rebuilt each step.
-  std::vector<Real> df_alpha_, df_kappa_;
-  // Per pair slot of the rows (nl_.indices.size()): the step's kernel gradients (the vectors: the sweeps
-  // read them in order, where a scalar W'(r)/r would have them gather x_j; docs/benchmarks.md).
-  std::vector<V> df_grad_;
-  std::vector<V> df_gsum_, df_gwall_, df_mv_;  // DFSPH: per-step sums and the sweeps' gathered w_j v_j
-  std::vector<Real> df_mk_;                    // DFSPH: the sweeps' gathered m_j k_j
-  std::vector<V> cg_v0_;                       // DFSPH's CG density solve (models/dfsph_cg.hpp)
-  std::vector<Real> cg_s_, cg_p_, cg_ap_;
-  std::vector<std::uint8_t> cg_active_;
-  Real df_diameter_ = 0;
-  DfsphStats dfsph_stats_;
+  Real particle_diameter_ = 0;            // the implicit solvers' CFL length (once, from the fluid)
   // DFSPH's passes run over the fluid split between the threads by row length (pass_driver.hpp), rebuilt
   // each step. A particle's own loads and stores weigh about as much as four pairs' (a pair reads 16
   // bytes in order and gathers one or three values; a particle some 60 bytes).
   BalancedIndexSet fluid_split_;
   static constexpr std::uint64_t kBalanceParticleWeight = 4;
 
-  // Emitters and sinks (config inflow, emitters.hpp): each emitter's frame and layer lattice (from the
-  // config) and its plane as the passes read it, its `advance` and the next free id (integrator state,
-  // checkpointed); the step's buffer (per particle its emitter or -1 and its start position; valid for the
-  // fluid slots while holding_), rebuilt every step; which emitters are active at the step's start.
-  std::vector<EmitterFrame<Dim, Real>> frames_;
-  std::vector<EmitterPlane<Dim, Real>> emitter_planes_;
-  std::vector<double> advance_;
-  std::uint64_t next_id_ = 0;
-  std::vector<std::int32_t> held_of_;
-  std::vector<V> held_x_;
-  bool holding_ = false;
-  std::vector<std::uint8_t> active_;
+  // Emitters and sinks (config inflow): the component with its buffer and its part of the integrator state.
+  EmittersAndSinks<Dim, Real> inflow_;
 };
 
 extern template class Simulation<2, float>;

@@ -19,9 +19,8 @@
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/timer.hpp"
-#include "cellsph/solver/boundary/adami2012.hpp"
-#include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
 #include "cellsph/solver/boundary/wall_motion.hpp"
+#include "cellsph/solver/boundary/wall_states.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/device/device_driver.hpp"
 #include "cellsph/solver/device/device_grid.hpp"
@@ -29,16 +28,67 @@
 #include "cellsph/solver/device/memory_space.hpp"
 #include "cellsph/solver/emitters.hpp"
 #include "cellsph/solver/integration/collisions.hpp"
-#include "cellsph/solver/models/continuity_density.hpp"
+#include "cellsph/solver/models/density_pressure.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
-#include "cellsph/solver/models/paper_multiphase.hpp"
-#include "cellsph/solver/models/summation_density.hpp"
+#include "cellsph/solver/models/model_registry.hpp"
 #include "cellsph/solver/models/wcsph.hpp"
 #include "cellsph/solver/particle_view.hpp"
 #include "cellsph/solver/stability_check.hpp"
-#include "cellsph/solver/timestep/global_courant.hpp"
 
 namespace cellsph {
+
+template <int Dim, class Real, class Space>
+class DeviceStepper;
+
+// What a model's stepper (models/model_stepper.hpp) sees of a device backend: the DeviceStepper's arrays in
+// `Space`, its index sets and rows, the step's input (clock, step number) and its result (timings).
+template <int Dim, class Real, class Space>
+class DeviceStepContext {
+ public:
+  template <class T>
+  using Array = DeviceArray<T, Space>;
+  using Stepper = DeviceStepper<Dim, Real, Space>;
+
+  DeviceStepContext(Stepper& s, const DeviceStepInput<Real>& in, DeviceStepResult<Real>& r, Stopwatch& sw)
+      : s_(s), clock_(in.clock), step_(in.step), r_(r), sw_(sw) {}
+  [[nodiscard]] const SolverConfig<Dim, Real>& cfg() const { return s_.cfg_; }
+  [[nodiscard]] ParticleView<Dim, Real> view() { return s_.view(); }
+  [[nodiscard]] DeviceIndexSet<Space> fluid() const { return {s_.fluid_.data(), s_.fluid_.size()}; }
+  [[nodiscard]] DeviceIndexSet<Space> fluid_by_pairs() const { return fluid(); }
+  [[nodiscard]] DeviceRange<Space> all() const { return DeviceRange<Space>{s_.n_}; }
+  [[nodiscard]] std::size_t size() const { return s_.n_; }
+  [[nodiscard]] std::size_t fluid_count() const { return s_.fluid_.size(); }
+  [[nodiscard]] std::size_t pair_slots() const { return s_.rows_.size(); }
+  void density(const ParticleView<Dim, Real>& pv) { fluid_density_pressure(s_.cfg_, pv, fluid()); }
+  void wall_states(const ParticleView<Dim, Real>& pv) {
+    if (s_.wall_states_)
+      cellsph::wall_states(s_.cfg_, pv, DeviceIndexSet<Space>{s_.boundary_.data(), s_.boundary_.size()});
+  }
+  void body_loads(const ParticleView<Dim, Real>& pv) {
+    if (s_.body_slot_.size() > 0) s_.body_forces(pv);
+  }
+  [[nodiscard]] bool any_tension() const { return s_.any_tension_; }
+  [[nodiscard]] bool wall_states_on() const { return s_.wall_states_; }
+  [[nodiscard]] Real particle_diameter() const { return s_.diameter_; }
+  [[nodiscard]] std::uint64_t step_number() const { return step_; }
+  [[nodiscard]] LeapFrogClock<Real>& clock() { return clock_; }
+  void forces_done() {
+    DeviceOps<Space>::synchronize();
+    r_.forces_ms = sw_.ms();
+    sw_.reset();
+  }
+  // The Simulation counts a device step's work itself.
+  void count_density(std::size_t) {}
+  void count_forces(std::size_t) {}
+  void count_normals(std::size_t) {}
+
+ private:
+  Stepper& s_;
+  LeapFrogClock<Real> clock_;
+  std::uint64_t step_;
+  DeviceStepResult<Real>& r_;
+  Stopwatch& sw_;
+};
 
 template <int Dim, class Real, class Space>
 class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
@@ -48,7 +98,10 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   using Array = DeviceArray<T, Space>;
   using Ops = DeviceOps<Space>;
 
-  explicit DeviceStepper(const SolverConfig<Dim, Real>& cfg) : cfg_(cfg) {
+  using Context = DeviceStepContext<Dim, Real, Space>;
+
+  explicit DeviceStepper(const SolverConfig<Dim, Real>& cfg)
+      : cfg_(cfg), model_(make_model_stepper<Dim, Real, Context>(cfg_)) {
     const std::string why = device_step_unsupported(cfg_);
     CELLSPH_CHECK(why.empty(), why);
     std::vector<PhaseParams<Real>> params;
@@ -78,6 +131,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
           .push_back(static_cast<std::uint32_t>(i));
       rho0[i] = cfg_.phases[static_cast<std::size_t>(p.phase[i])].rest_density;
     }
+    if (diameter_ == 0) diameter_ = dfsph_particle_diameter<Dim, Real>(p.m.data(), rho0.data(), fluid);
     fluid_.upload(fluid.data(), fluid.size());
     boundary_.upload(boundary.data(), boundary.size());
     fluid_host_ = std::move(fluid);
@@ -85,14 +139,12 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     body_slot_.resize(0);
     rho0_.upload(rho0.data(), n_);
     wall_states_ = cfg_.wall_model != WallModel::Akinci && !boundary.empty();
-    for (auto* a : {&vol_, &prho2_, &drho_}) {
+    for (auto* a : {&vol_, &prho2_}) {
       a->resize(n_);
       a->zero();
     }
-    for (auto* a : {&f_pressure_, &wall_v_}) {
-      a->resize(n_);
-      a->zero();
-    }
+    wall_v_.resize(n_);
+    wall_v_.zero();
   }
 
   void upload_wall_self_density(const std::vector<Real>& rho) override {
@@ -156,14 +208,13 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     sw.reset();
     const DeviceIndexSet<Space> fluid{fluid_.data(), fluid_.size()};
     const bool holding = inflow_mark(in, fluid);
-    if (implicit_pressure(cfg_.model)) {
-      r.dt = dfsph(in, fluid);
-      Ops::synchronize();
-      r.forces_ms = sw.ms();
-      sw.reset();
-    } else {
-      explicit_step(in, fluid, r, sw);
+    if (df_kappa_v_.size() != n_) {  // the solver state, where upload_solver_state gave none
+      df_kappa_v_.resize(n_);
+      df_kappa_v_.zero();
     }
+    Context ctx(*this, in, r, sw);
+    r.dt = model_->advance(ctx);  // to the drift; the stepper ends the force phase's timing
+    r.leapfrog_started = ctx.clock().started;
     if (holding)
       run_pass(fluid, InflowHoldPass<Dim, Real>{d_.x.data(), d_.v.data(), held_.data(), held_x_.data(),
                                                 emitters_.data(), r.dt});
@@ -199,6 +250,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     df_kappa_v_.download(s.dfsph_kappa_v.data());
   }
 
+  DfsphStats* solver_stats() override { return model_->solver_stats(); }
+
   DeviceRows neighbor_rows() override {
     build_rows();
     DeviceRows h;
@@ -217,6 +270,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   }
 
  private:
+  friend class DeviceStepContext<Dim, Real, Space>;
+
   ParticleView<Dim, Real> view() {
     ParticleView<Dim, Real> v;
     v.n = n_;
@@ -224,24 +279,10 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.rho0 = rho0_.data();
     v.vol = vol_.data();
     v.prho2 = prho2_.data();
-    v.f_pressure = f_pressure_.data();
     v.wall_v = wall_v_.data();
-    v.drho = drho_.data();
     v.wall_self_rho = wall_self_rho_.data();
     v.wall_a = wall_a_.size() > 0 ? wall_a_.data() : nullptr;
-    v.df_alpha = df_alpha_.data();
-    v.df_kappa = df_kappa_.data();
     v.df_kappa_v = df_kappa_v_.data();
-    v.df_grad = df_grad_.data();
-    v.df_gsum = df_gsum_.data();
-    v.df_gwall = df_gwall_.data();
-    v.df_mv = df_mv_.data();
-    v.df_mk = df_mk_.data();
-    v.cg_v0 = cg_v0_.data();
-    v.cg_s = cg_s_.data();
-    v.cg_p = cg_p_.data();
-    v.cg_ap = cg_ap_.data();
-    v.cg_active = cg_active_.data();
     v.offsets = offsets_.data();
     v.candidates = rows_.data();
     v.within = rows_.data();
@@ -251,8 +292,6 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     v.phases = phases_.data();
     return v;
   }
-
-  bool paper() const { return cfg_.model == Model::PaperMultiphase; }
 
   // Simulation::inflow_mark: the buffer of the emitters active at the step's start (in.emitters_active, the
   // Simulation's flags); false when none is.
@@ -266,80 +305,6 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     return true;
   }
 
-  // WCSPH or the paper's model (Simulation::step's sequence): density, wall states, forces, dt, integration.
-  void explicit_step(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid,
-                     DeviceStepResult<Real>& r, Stopwatch& sw) {
-    const auto pv = view();
-    const DeviceIndexSet<Space> boundary{boundary_.data(), boundary_.size()};
-    if (continuity())
-      continuity_state(cfg_, pv, fluid);
-    else
-      summation_density(cfg_, pv, fluid);
-    if (wall_states_ && cfg_.wall_model == WallModel::Dynamic)
-      dynamic_wall_states(cfg_, pv, boundary);
-    else if (wall_states_)
-      adami2012_wall_states(cfg_, pv, boundary);
-    if (paper())
-      forces_paper(pv, fluid);
-    else
-      wcsph_forces(cfg_, pv, fluid, any_tension_, wall_states_);
-    if (body_slot_.size() > 0) body_forces(pv);
-    Ops::synchronize();
-    r.forces_ms = sw.ms();
-
-    sw.reset();
-    r.dt = global_courant_dt(cfg_, pv, fluid);
-    if (paper()) {
-      const Real kick = in.leapfrog_started ? (in.last_dt + r.dt) / 2 : r.dt / 2;  // integrate_paper
-      run_pass(fluid, PaperLeapFrogPass<Dim, Real>{pv, kick, r.dt});
-    } else {
-      integrate(pv, fluid, r.dt);
-    }
-  }
-
-  // DFSPH (models/dfsph.hpp, Simulation::step_dfsph): the step to the drift over the device's exact rows; its
-  // per-pair gradient factors sized from them, the divergence warm start carried (upload_solver_state).
-  Real dfsph(const DeviceStepInput<Real>& in, const DeviceIndexSet<Space>& fluid) {
-    CELLSPH_CHECK(in.dfsph != nullptr, "a DFSPH step needs its statistics");
-    df_alpha_.resize(n_);
-    df_kappa_.resize(n_);
-    if (df_kappa_v_.size() != n_) {
-      df_kappa_v_.resize(n_);
-      df_kappa_v_.zero();
-    }
-    df_grad_.resize(rows_.size());
-    df_gsum_.resize(n_);
-    df_gwall_.resize(n_);
-    df_mv_.resize(n_);
-    df_mk_.resize(n_);
-    if (cfg_.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient) {
-      cg_v0_.resize(n_);
-      cg_s_.resize(n_);
-      cg_p_.resize(n_);
-      cg_ap_.resize(n_);
-      cg_active_.resize(n_);
-    }
-    if (cfg_.model == Model::Iisph)
-      return iisph_step(cfg_, view(), fluid, DeviceRange<Space>{n_}, in.dfsph_diameter, *in.dfsph, in.step);
-    return dfsph_step(cfg_, view(), fluid, DeviceRange<Space>{n_}, in.dfsph_diameter, *in.dfsph, in.step);
-  }
-
-  // Simulation::compute_forces_paper: the colour normals (every particle's cleared first) when the tension
-  // model needs them, then the forces (models/paper_multiphase.hpp).
-  void forces_paper(const ParticleView<Dim, Real>& pv, const DeviceIndexSet<Space>& fluid) {
-    const auto tension = PaperTension::of(cfg_, any_tension_);
-    if (tension.needs_normals()) {
-      normal_.resize(n_);
-      normal_.zero();
-      auto with_normals = pv;
-      with_normals.normal = normal_.data();
-      paper_normals(cfg_, with_normals, fluid);
-      paper_forces(cfg_, with_normals, fluid, tension, wall_states_);
-      return;
-    }
-    paper_forces(cfg_, pv, fluid, tension, wall_states_);
-  }
-
   // Simulation::compute_body_loads's passes: each body particle's reaction to its fluid neighbours (the
   // WCSPH pass's own wall term) and its contacts, into body_f_ (summed on the host).
   void body_forces(const ParticleView<Dim, Real>& pv) {
@@ -351,21 +316,6 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     auto contact = contact_;
     contact.pv = pv;
     run_pass(all, contact);
-  }
-
-  bool continuity() const { return cfg_.density_evolution == DensityEvolution::Continuity; }
-
-  // Simulation::integrate_wcsph's sequence: symplectic Euler, or with the continuity density the kick, the
-  // density rate at the old positions, the density update and the drift (models/continuity_density.hpp).
-  void integrate(const ParticleView<Dim, Real>& pv, const DeviceIndexSet<Space>& fluid, Real dt) {
-    if (!continuity()) {
-      run_pass(fluid, WcsphSymplecticEulerPass<Dim, Real>{pv, dt});
-      return;
-    }
-    run_pass(fluid, WcsphKickPass<Dim, Real>{pv, dt});
-    continuity_rate(cfg_, pv, fluid);
-    run_pass(fluid, ContinuityIntegratePass<Dim, Real>{pv, dt});
-    run_pass(fluid, WcsphDriftPass<Dim, Real>{pv, dt});
   }
 
   // The sorted grid (device_grid.hpp) and the rows of the fluid (and, for wall states, of the walls).
@@ -451,13 +401,13 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<Plane<Dim, Real>> planes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
   std::vector<std::uint32_t> fluid_host_;
-  Array<Real> rho0_, vol_, prho2_, drho_, wall_self_rho_;
-  Array<Real> df_alpha_, df_kappa_, df_kappa_v_, df_mk_;  // DFSPH (models/dfsph.hpp)
-  Array<V> df_grad_, df_gsum_, df_gwall_, df_mv_;
-  Array<Real> cg_s_, cg_p_, cg_ap_;  // DFSPH's CG density solve (models/dfsph_cg.hpp)
-  Array<V> cg_v0_;
-  Array<std::uint8_t> cg_active_;
-  Array<V> f_pressure_, wall_v_, normal_;
+  // The model's stepper (models/model_registry.hpp), which owns the arrays only its model reads, and the
+  // implicit solvers' CFL length (from the first upload's fluid).
+  std::unique_ptr<ModelStepper<Dim, Real, Context>> model_;
+  Real diameter_ = 0;
+  Array<Real> rho0_, vol_, prho2_, wall_self_rho_;
+  Array<Real> df_kappa_v_;  // the solver state (SolverState: DFSPH's divergence warm start)
+  Array<V> wall_v_;
   // Moving walls: the config's motions and table rows; per moving wall its slot, initial position, motion;
   // every particle's wall acceleration (empty when nothing moves).
   Array<WallMotion> motions_;

@@ -11,6 +11,7 @@
 
 #include "cellsph/solver/boundary/rigid_bodies.hpp"
 #include "cellsph/solver/config.hpp"
+#include "cellsph/solver/models/model_stepper.hpp"
 #include "cellsph/solver/particles.hpp"
 
 namespace cellsph {
@@ -23,22 +24,16 @@ struct DeviceStepResult {
   double neighbors_ms = 0;          // wall time of the phases (the device synchronised between them)
   double forces_ms = 0;
   double integration_ms = 0;
+  bool leapfrog_started = false;  // the paper's leap-frog after the step (LeapFrogClock::started)
 };
 
-// What a step needs of the Simulation's state: the clock (moving walls), and for the paper's leap-frog the
-// last step and whether the leap-frog has started.
-struct DfsphStats;  // models/dfsph.hpp
-
+// What a step needs of the Simulation's state: the clock (moving walls), the paper's leap-frog clock, and
+// the number of the step being taken (1-based, for messages).
 template <class Real>
 struct DeviceStepInput {
   Real time = 0;
-  Real last_dt = 0;
-  bool leapfrog_started = false;
-  // DFSPH: the number of the step being taken (1-based, for messages), the particle diameter of its CFL
-  // step (computed once by the Simulation) and the statistics the step adds to.
+  LeapFrogClock<Real> clock{};
   std::uint64_t step = 0;
-  Real dfsph_diameter = 0;
-  DfsphStats* dfsph = nullptr;
   // Emitters (emitters.hpp): per emitter 1 when it is active at the step's start (host memory, the
   // Simulation's); null when none is (no buffer is held).
   const std::uint8_t* emitters_active = nullptr;
@@ -87,14 +82,17 @@ class DeviceStepperBase {
   virtual void download_body_forces(std::vector<Vec<Dim, double>>& f, std::vector<Vec<Dim, Real>>& x) = 0;
   // The body particles where `states` put them (BodyPlacePass: position, velocity, wall acceleration).
   virtual void place_bodies(const std::vector<RigidBodyState>& states) = 0;
-  // One step of Simulation::step() with a global step: the emitters' buffer marked, neighbour rows,
-  // density, wall states, forces (WCSPH or the paper's model), dt, integration (symplectic Euler or the
-  // paper's leap-frog), the buffer held, box and planes, the stability check, the moving walls at the new
-  // time, then the sink test. Positions are left as computed even when the check fails (as on the CPU).
-  // Emitting and removing particles is the Simulation's (on the host, then upload() again).
+  // One step of Simulation::step() with a global step: the emitters' buffer marked, neighbour rows, the
+  // model's stepper (models/model_stepper.hpp: density to the drift), the buffer held, box and planes, the
+  // stability check, the moving walls at the new time, then the sink test. Positions are left as computed
+  // even when the check fails (as on the CPU). Emitting and removing particles is the Simulation's (on the
+  // host, then upload() again).
   virtual DeviceStepResult<Real> step(const DeviceStepInput<Real>& in) = 0;
   // The rows of the current positions (built afresh), copied to the host.
   virtual DeviceRows neighbor_rows() = 0;
+  // The model's implicit solves' statistics (models/model_stepper.hpp), in host memory; null for the
+  // explicit models.
+  virtual DfsphStats* solver_stats() = 0;
 };
 
 // Empty when the device step runs this config; otherwise what it lacks, in one phrase.

@@ -41,7 +41,7 @@
 //  * k_i alone changes D rho_i / Dt by -dt k_i sum_l m_i |G_il|^2 / m_l, so
 //    alpha_i = 1 / (|G_ii|^2 + sum_j m_i^3 / m_j |grad W_ij|^2), the Jacobi diagonal again.
 // For one phase (m_j = m_i, rho0 of the walls = rho0_i) every term is the mass density's; that path keeps
-// its own expressions (number = false), so its bits did not change.
+// its own expressions (number = false).
 //
 // The density uses the density kernel, and so do its gradient (the time derivative of that density) and
 // the viscosity's gradient: pressure_kernel is not read by this model.
@@ -82,6 +82,7 @@ struct DfsphStats {
   double last_hit_bound = 0;             // its bound [%],
   int last_hit_iterations = 0;           // its sweeps (or iterations)
   const char* last_hit_solve = "";       // and which solve it was ("DFSPH constant-density"; a literal)
+  const char* last_hit_unit = "sweeps";  // what its iterations are called ("sweeps", "iterations"; a literal)
   // Wall time of the step's stages [ms, summed]: ms_divergence includes the non-pressure forces (summed in
   // the divergence solve's last pass), ms_nonpressure is their kick.
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
@@ -462,6 +463,7 @@ inline void implicit_check_solve(DfsphStats& st, const DfsphSolveResult& r, doub
     st.last_hit_bound = eta * 100;
     st.last_hit_iterations = r.iterations;
     st.last_hit_solve = what;
+    st.last_hit_unit = unit;
   }
 }
 
@@ -512,12 +514,16 @@ DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, 
   }
 }
 
-// The particle diameter d = min over fluid particles of (m / rho0)^(1/Dim) (host, once per run).
+// The particle diameter d = min over fluid particles of (m / rho0)^(1/Dim) (host arrays, once per run).
+template <int Dim, class Real>
+Real dfsph_particle_diameter(const Real* m, const Real* rho0, const IndexSet& fluid) {
+  Real vmin = std::numeric_limits<Real>::max();
+  for (const std::uint32_t i : fluid) vmin = std::min(vmin, m[i] / rho0[i]);
+  return fluid.empty() ? Real(0) : static_cast<Real>(std::pow(double(vmin), 1.0 / Dim));
+}
 template <int Dim, class Real>
 Real dfsph_particle_diameter(const ParticleView<Dim, Real>& pv, const IndexSet& fluid) {
-  Real vmin = std::numeric_limits<Real>::max();
-  for (const std::uint32_t i : fluid) vmin = std::min(vmin, pv.m[i] / pv.rho0[i]);
-  return fluid.empty() ? Real(0) : static_cast<Real>(std::pow(double(vmin), 1.0 / Dim));
+  return dfsph_particle_diameter<Dim, Real>(pv.m, pv.rho0, fluid);
 }
 
 // Step 2 (DFSPH and IISPH): the step from the velocities at its start: time.dt when the stepping is fixed,

@@ -1,0 +1,131 @@
+#pragma once
+// Bender & Koschier's divergence-free SPH (models/dfsph.hpp: dfsph_step), and the arrays and statistics
+// it shares with IISPH (iisph_stepper.hpp): per particle the factor alpha, a sweep's k, the step's kernel
+// gradient sums and the sweeps' gathered values; per pair slot of the rows the kernel gradient; with the
+// conjugate-gradient density solve (models/dfsph_cg.hpp) its vectors.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cellsph/solver/config.hpp"
+#include "cellsph/solver/models/dfsph.hpp"
+#include "cellsph/solver/models/model_stepper.hpp"
+
+namespace cellsph {
+
+// printf's rendering of one number.
+inline std::string format_number(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// ", N solves at max_iterations" of the progress line (nothing while there are none).
+inline std::string implicit_hits_progress(const DfsphStats& st) {
+  return st.max_iteration_hits > 0 ? ", " + std::to_string(st.max_iteration_hits) + " solves at max_iterations"
+                                   : std::string();
+}
+
+// The summary's errors: "density error last L% max M% (bound B%), N solves stopped at max_iterations[ (last:
+// step S, error E%)]".
+inline std::string implicit_errors_summary(const DfsphStats& st, double bound) {
+  std::string s = "density error last " + format_number("%.3g", st.last_density_error) + "% max " +
+                  format_number("%.3g", st.max_density_error) + "% (bound " + format_number("%.3g", bound) +
+                  "%), " + std::to_string(st.max_iteration_hits) + " solves stopped at max_iterations";
+  if (st.max_iteration_hits)
+    s += " (last: step " + std::to_string(st.last_hit_step) + ", error " + format_number("%.3g", st.last_hit_error) +
+         "%)";
+  return s;
+}
+
+template <int Dim, class Real, class Ctx>
+class ImplicitPressureStepper : public ModelStepper<Dim, Real, Ctx> {
+ public:
+  DfsphStats* solver_stats() override { return &stats_; }
+
+ protected:
+  // The step's arrays sized and attached to the view; the particle diameter of the CFL step, once.
+  ParticleView<Dim, Real> prepare(Ctx& c) {
+    const std::size_t n = c.size();
+    c.count_density(c.fluid_count());
+    c.count_forces(c.fluid_count());
+    for (auto* a : {&alpha_, &kappa_, &mk_}) a->resize(n);
+    for (auto* a : {&gsum_, &gwall_, &mv_}) a->resize(n);
+    grad_.resize(c.pair_slots());
+    if (c.cfg().dfsph.density_solver == DfsphDensitySolver::ConjugateGradient) {
+      for (auto* a : {&cg_s_, &cg_p_, &cg_ap_}) a->resize(n);
+      cg_v0_.resize(n);
+      cg_active_.resize(n);
+    }
+    if (diameter_ == 0) diameter_ = c.particle_diameter();
+    ParticleView<Dim, Real> pv = c.view();
+    pv.df_alpha = alpha_.data();
+    pv.df_kappa = kappa_.data();
+    pv.df_grad = grad_.data();
+    pv.df_gsum = gsum_.data();
+    pv.df_gwall = gwall_.data();
+    pv.df_mv = mv_.data();
+    pv.df_mk = mk_.data();
+    pv.cg_v0 = cg_v0_.data();
+    pv.cg_s = cg_s_.data();
+    pv.cg_p = cg_p_.data();
+    pv.cg_ap = cg_ap_.data();
+    pv.cg_active = cg_active_.data();
+    return pv;
+  }
+
+  template <class T>
+  using Array = typename Ctx::template Array<T>;
+  Array<Real> alpha_, kappa_, mk_;
+  Array<Vec<Dim, Real>> grad_, gsum_, gwall_, mv_;
+  Array<Real> cg_s_, cg_p_, cg_ap_;
+  Array<Vec<Dim, Real>> cg_v0_;
+  Array<std::uint8_t> cg_active_;
+  Real diameter_ = 0;
+  DfsphStats stats_;
+};
+
+template <int Dim, class Real, class Ctx>
+class DfsphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
+ public:
+  explicit DfsphStepper(const SolverConfig<Dim, Real>& cfg) : bound_(double(cfg.dfsph.max_density_error)) {}
+
+  // The last step's sweeps (density + divergence), its average density error and step.
+  [[nodiscard]] std::string progress(const DfsphStats& st, Real last_dt) const override {
+    return "  dfsph " + std::to_string(st.last_density_iterations) + "+" +
+           std::to_string(st.last_divergence_iterations) + " sweeps, err " +
+           format_number("%.3f", st.last_density_error) + "%, dt " + format_number("%.3g", 1e3 * double(last_dt)) +
+           " ms" + implicit_hits_progress(st);
+  }
+  // Sweeps a step, errors and solves stopped at max_iterations; where a step's time goes (the non-pressure
+  // forces are summed in the divergence solve's last pass: their time is the solve's).
+  [[nodiscard]] std::vector<std::string> summary(const DfsphStats& st, double search_ms) const override {
+    const double n = double(std::max<std::uint64_t>(st.steps, 1));
+    const double sweeps = double(st.density_iterations);
+    return {"dfsph: " + format_number("%.2f", sweeps / n) + " density + " +
+                format_number("%.2f", double(st.divergence_iterations) / n) + " divergence sweeps/step, " +
+                implicit_errors_summary(st, bound_),
+            "dfsph ms/step: search " + format_number("%.3g", search_ms / n) + ", density+alpha " +
+                format_number("%.3g", st.ms_factor / n) + ", divergence solve + non-pressure forces " +
+                format_number("%.3g", st.ms_divergence / n) + ", kick " +
+                format_number("%.3g", st.ms_nonpressure / n) + ", density solve " +
+                format_number("%.3g", st.ms_density / n) + ", drift " + format_number("%.3g", st.ms_drift / n) +
+                " (" + format_number("%.3g", sweeps > 0 ? st.ms_density / sweeps : 0.0) + " ms a density sweep)"};
+  }
+
+  Real advance(Ctx& c) override {
+    const ParticleView<Dim, Real> pv = this->prepare(c);
+    const Real dt =
+        dfsph_step(c.cfg(), pv, c.fluid_by_pairs(), c.all(), this->diameter_, this->stats_, c.step_number());
+    c.forces_done();
+    return dt;
+  }
+
+ private:
+  double bound_;  // dfsph.max_density_error [%]
+};
+
+}  // namespace cellsph
