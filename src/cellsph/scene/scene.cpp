@@ -516,7 +516,7 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
     // A CFL step moves the fastest particle 0.4 d, three times the 0.45 of the default skin after which
     // the lists are rebuilt, so skinned lists seldom last a step; without the skin the rows, the stored
     // gradients and the row cut take less memory (peak heap 1.17x WCSPH's against 1.64x with the default
-    // skin; docs/benchmarks.md, DFSPH in 3D, "The gradients stored as vectors again").
+    // skin; docs/benchmarks.md, "DFSPH and IISPH against WCSPH and SPlisHSPlasH (3D)", memory).
     cfg.verlet_skin = Real(0);
   }
   cfg.backend = *parse_backend(sr.choice("backend", "cpu", {"cpu", "cuda", "host-device"}));
