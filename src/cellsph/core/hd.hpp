@@ -21,10 +21,9 @@
 // Before a pair loop that sums in row order (the sweeps' rates and kicks): keeps the host compiler from
 // vectorizing it. GCC 12 otherwise takes two pairs an iteration in an in-order (strict IEEE) reduction,
 // with about ten shuffles a pair that cost more than they save: one pair an iteration is 10-15% faster
-// (docs/benchmarks.md, "What do the compiler and the build options change?"). The sums and their order,
-// hence the bits, are the same either way. The loop must be in OpenMP's canonical form (an integer
-// index). Empty in device code.
-#if defined(__CUDA_ARCH__)
+// (docs/benchmarks.md, "What do the compiler and the build options change?"). The sums, their order and
+// the bits are the same either way. The loop must be in OpenMP's canonical form (an integer index).
+#if defined(__CUDA_ARCH__)  // empty in device code
 #define CELLSPH_SCALAR_LOOP
 #elif defined(__clang__)
 #define CELLSPH_SCALAR_LOOP _Pragma("clang loop vectorize(disable) interleave(disable)")
