@@ -410,83 +410,131 @@ double fluid_volume(const nlohmann::json& j, const std::string& source) {
   return v;
 }
 
-void run_bench_sph(const SphArgs& a) {
-  const auto methods = parse_methods(a.methods);
-  auto sizes = parse_list<std::size_t>("--sizes", a.sizes, 1);
-  const auto models = split(a.models);
-  for (const auto& m : models)
-    if (m != "wcsph" && m != "paper")
-      throw InputError("--models: unknown model '" + m + "' (expected wcsph,paper)");
-  const auto precisions = split(a.precisions);
-  for (const auto& p : precisions)
-    if (p != "float" && p != "double")
-      throw InputError("--precisions: unknown precision '" + p + "' (expected float,double)");
-  const auto backend = parse_backend(a.backend);
-  if (!backend) throw InputError("--backend: unknown backend '" + a.backend + "' (expected cpu or cuda)");
-  require_backend(*backend, "--backend");
-  const bool on_device = *backend != Backend::Cpu;
-  if (a.steps < 1) throw InputError("--steps: must be >= 1, got " + std::to_string(a.steps));
-  if (a.warmup < 0) throw InputError("--warmup: must be >= 0, got " + std::to_string(a.warmup));
-  if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
-  if (a.skin != -1 && !(a.skin >= 0 && a.skin <= 1))
-    throw InputError("--skin: must be in [0, 1], got " + std::to_string(a.skin));
+// What `bench sph` runs, from its checked arguments.
+struct SphPlan {
+  std::vector<Method> methods;
+  std::vector<std::size_t> sizes;
+  std::vector<std::string> models, precisions;
+  Backend backend = Backend::Cpu;
   std::vector<long> reorders;  // empty: the scenes' value
-  for (const auto& r : a.reorder.empty() ? std::vector<std::string>{} : split(a.reorder)) {
+  int steps = 0, warmup = 0;
+};
+
+// The --reorder list of step counts.
+std::vector<long> parse_reorders(const std::string& text) {
+  std::vector<long> reorders;
+  for (const auto& r : text.empty() ? std::vector<std::string>{} : split(text)) {
     char* end = nullptr;
     const long v = std::strtol(r.c_str(), &end, 10);
     if (r.empty() || *end != 0 || v < 0 || v > 1000000)
       throw InputError("--reorder: '" + r + "' is not a step count in [0, 1000000]");
     reorders.push_back(v);
   }
+  return reorders;
+}
+
+SphPlan plan_bench_sph(const SphArgs& a) {
+  SphPlan p;
+  p.methods = parse_methods(a.methods);
+  p.sizes = parse_list<std::size_t>("--sizes", a.sizes, 1);
+  p.models = split(a.models);
+  for (const auto& m : p.models)
+    if (m != "wcsph" && m != "paper")
+      throw InputError("--models: unknown model '" + m + "' (expected wcsph,paper)");
+  p.precisions = split(a.precisions);
+  for (const auto& pr : p.precisions)
+    if (pr != "float" && pr != "double")
+      throw InputError("--precisions: unknown precision '" + pr + "' (expected float,double)");
+  const auto backend = parse_backend(a.backend);
+  if (!backend) throw InputError("--backend: unknown backend '" + a.backend + "' (expected cpu or cuda)");
+  require_backend(*backend, "--backend");
+  p.backend = *backend;
+  if (a.steps < 1) throw InputError("--steps: must be >= 1, got " + std::to_string(a.steps));
+  if (a.warmup < 0) throw InputError("--warmup: must be >= 0, got " + std::to_string(a.warmup));
+  if (a.threads < 1) throw InputError("--threads: must be >= 1, got " + std::to_string(a.threads));
+  if (a.skin != -1 && !(a.skin >= 0 && a.skin <= 1))
+    throw InputError("--skin: must be in [0, 1], got " + std::to_string(a.skin));
+  p.reorders = parse_reorders(a.reorder);
   if (a.subdivision < 0 || a.subdivision > 16)
     throw InputError("--subdivision: must be in [1, 16], got " + std::to_string(a.subdivision));
-  int steps = a.steps, warmup = a.warmup;
+  p.steps = a.steps;
+  p.warmup = a.warmup;
   if (a.quick) {
-    sizes = {2000};
-    steps = std::min(steps, 3);
-    warmup = std::min(warmup, 1);
+    p.sizes = {2000};
+    p.steps = std::min(p.steps, 3);
+    p.warmup = std::min(p.warmup, 1);
   }
-  ScopedThreads threads(a.threads);
+  return p;
+}
 
+void print_bench_sph_legend(const SphArgs& a, const SphPlan& p) {
   std::printf("cellsph bench sph: %d thread(s), %d warm-up step(s), then the mean of %d step(s)\n",
-              max_threads(), warmup, steps);
+              max_threads(), p.warmup, p.steps);
   std::printf(
       "  search = NeighborSearch build + find_all (Verlet lists: only when a particle has moved\n"
       "  0.45 skin; builds = searches run in the timed steps) + the displacement check; dynamics =\n"
       "  density, forces, time step, integration, walls, stability check (Simulation::timings());\n"
       "  nbr%% = search / step; step ms of the 3D table (wall) also holds the reorders into cell order.\n");
-
-  if (on_device)
+  if (p.backend != Backend::Cpu)
     std::printf(
         "  backend %s: the step runs on the device (rows rebuilt every step by its sorted grid: builds =\n"
         "  steps); Table 1 and the paper model are CPU only (docs/gpu.md).\n",
         a.backend.c_str());
-  if (!on_device) {
-    std::printf(
-        "\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
-        a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
-    std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
-                "step ms", "nbr%", "builds", "pairs");
-    for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
-      std::string source;
-      const nlohmann::json base = read_scene_json(name, source);
-      for (Method m : methods) {
-        nlohmann::json j = base;
-        j["neighbors"]["method"] = std::string(method_name(m));
-        if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
-        if (!reorders.empty()) j["neighbors"]["reorder_every"] = reorders.front();
-        if (a.subdivision > 0) j["neighbors"]["subdivision"] = a.subdivision;
-        const StepFigures f = time_scene({j}, source, warmup, steps).front();
-        const double step = f.neighbors_ms + f.dynamics_ms;
-        std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
-                    std::string(method_name(m)).c_str(), f.neighbors_ms, f.dynamics_ms, step,
-                    100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
-                    static_cast<unsigned long long>(f.pairs));
-        std::fflush(stdout);
-      }
+}
+
+// Table 1: the paper's three dam breaks (paper model, double), one row per scene and method.
+void bench_paper_dam_breaks(const SphArgs& a, const SphPlan& p) {
+  std::printf(
+      "\n== Table 1: the paper's dam breaks (3D, 1600 fluid particles, paper model, double, H = %s) ==\n",
+      a.subdivision > 0 ? std::to_string(a.subdivision).c_str() : "the scene's");
+  std::printf("  %-18s %-13s %11s %12s %10s %6s %7s %10s\n", "scene", "method", "search ms", "dynamics ms",
+              "step ms", "nbr%", "builds", "pairs");
+  for (const char* name : {"paper-dam-break-1", "paper-dam-break-2", "paper-dam-break-3"}) {
+    std::string source;
+    const nlohmann::json base = read_scene_json(name, source);
+    for (Method m : p.methods) {
+      nlohmann::json j = base;
+      j["neighbors"]["method"] = std::string(method_name(m));
+      if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
+      if (!p.reorders.empty()) j["neighbors"]["reorder_every"] = p.reorders.front();
+      if (a.subdivision > 0) j["neighbors"]["subdivision"] = a.subdivision;
+      const StepFigures f = time_scene({j}, source, p.warmup, p.steps).front();
+      const double step = f.neighbors_ms + f.dynamics_ms;
+      std::printf("  %-18s %-13s %11.3f %12.3f %10.3f %5.1f%% %7llu %10llu\n", name,
+                  std::string(method_name(m)).c_str(), f.neighbors_ms, f.dynamics_ms, step,
+                  100 * f.neighbors_ms / step, static_cast<unsigned long long>(f.builds),
+                  static_cast<unsigned long long>(f.pairs));
+      std::fflush(stdout);
     }
   }
+}
 
+// The variants of one 3D case: dam-break-3d at `spacing` (support 2 spacing, Cell Indexing) with the
+// model, precision and backend asked for, once per --reorder value (or once with the scene's).
+std::vector<nlohmann::json> dam_break_variants(const nlohmann::json& base, double spacing,
+                                               const std::string& model, const std::string& prec,
+                                               const SphArgs& a, const SphPlan& p) {
+  nlohmann::json j = base;
+  j["spacing"] = spacing;
+  j["solver"]["support"] = 2 * spacing;
+  j["solver"]["model"] = model;
+  // The paper model has no artificial viscosity (eq. 8b with the phase's mu only).
+  if (model == "paper") j["solver"].erase("artificial_viscosity");
+  j["precision"] = prec;
+  j["neighbors"]["method"] = "cell-index";
+  j["solver"]["backend"] = std::string(backend_name(p.backend));
+  if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
+  std::vector<nlohmann::json> variants;
+  for (const long r : p.reorders) {
+    variants.push_back(j);
+    variants.back()["neighbors"]["reorder_every"] = r;
+  }
+  if (variants.empty()) variants.push_back(j);
+  return variants;
+}
+
+// The 3D dam break at each fluid count, model and precision asked for.
+void bench_dam_break_3d(const SphArgs& a, const SphPlan& p) {
   std::string source;
   const nlohmann::json base = read_scene_json("dam-break-3d", source);
   const double volume = fluid_volume(base, source);
@@ -496,32 +544,17 @@ void run_bench_sph(const SphArgs& a) {
   std::printf("  %-8s %-7s %8s %10s %10s %11s %12s %10s %6s %7s %14s %8s %11s\n", "model", "real", "reorder",
               "fluid", "total", "search ms", "dynamics ms", "step ms", "nbr%", "builds", "Mfluid-steps/s",
               "t end s", "pairs/fluid");
-  for (std::size_t n : sizes) {
+  for (std::size_t n : p.sizes) {
     const double spacing = std::cbrt(volume / static_cast<double>(n));
-    for (const auto& model : models) {
-      if (on_device && model != "wcsph") continue;
-      for (const auto& prec : precisions) {
-        nlohmann::json j = base;
-        j["spacing"] = spacing;
-        j["solver"]["support"] = 2 * spacing;
-        j["solver"]["model"] = model;
-        // The paper model has no artificial viscosity (eq. 8b with the phase's mu only).
-        if (model == "paper") j["solver"].erase("artificial_viscosity");
-        j["precision"] = prec;
-        j["neighbors"]["method"] = "cell-index";
-        j["solver"]["backend"] = std::string(backend_name(*backend));
-        if (a.skin >= 0) j["neighbors"]["skin"] = a.skin;
-        std::vector<nlohmann::json> variants;
-        for (const long r : reorders) {
-          variants.push_back(j);
-          variants.back()["neighbors"]["reorder_every"] = r;
-        }
-        if (variants.empty()) variants.push_back(j);
-        const auto figures = time_scene(variants, source, warmup, steps);
+    for (const auto& model : p.models) {
+      if (p.backend != Backend::Cpu && model != "wcsph") continue;
+      for (const auto& prec : p.precisions) {
+        const auto variants = dam_break_variants(base, spacing, model, prec, a, p);
+        const auto figures = time_scene(variants, source, p.warmup, p.steps);
         for (std::size_t k = 0; k < figures.size(); ++k) {
           const StepFigures& f = figures[k];
           const double step = f.neighbors_ms + f.dynamics_ms;
-          const std::string reorder = reorders.empty() ? "scene" : std::to_string(reorders[k]);
+          const std::string reorder = p.reorders.empty() ? "scene" : std::to_string(p.reorders[k]);
           std::printf("  %-8s %-7s %8s %10zu %10zu %11.2f %12.2f %10.2f %5.1f%% %7llu %14.3f %8.3f %11.1f\n",
                       model.c_str(), prec.c_str(), reorder.c_str(), f.fluid, f.total, f.neighbors_ms,
                       f.dynamics_ms, f.wall_ms, 100 * f.neighbors_ms / step,
@@ -534,6 +567,14 @@ void run_bench_sph(const SphArgs& a) {
       }
     }
   }
+}
+
+void run_bench_sph(const SphArgs& a) {
+  const SphPlan plan = plan_bench_sph(a);
+  ScopedThreads threads(a.threads);
+  print_bench_sph_legend(a, plan);
+  if (plan.backend == Backend::Cpu) bench_paper_dam_breaks(a, plan);
+  bench_dam_break_3d(a, plan);
 }
 
 }  // namespace

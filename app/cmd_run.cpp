@@ -248,16 +248,19 @@ void remove_stale_temporaries(const std::filesystem::path& dir) {
   for (const auto& p : stale) std::filesystem::remove(p, ec);
 }
 
-// Runs one scene. Two phases: first everything is read, validated and built (scene, options,
-// particles, Simulation, the checkpoint and the frame index of a resume) without writing anything, so a
-// failed start leaves the output location as it was; then `start_output` makes the folder and run.json,
-// and the frames follow.
+// The run's output settings: the scene's output section with the command line's end time, frame rate,
+// frame formats and picture colours over it, and the picture and surface options that follow.
+struct RunOutputSettings {
+  OutputSettings os;
+  OutputFormats formats;
+  RenderOptions ropt;
+  SurfaceOptions sopt;
+};
+
+// --method and --backend over the scene's solver section. Without --backend the scene's own backend is
+// checked here, before anything is written.
 template <int Dim, class Real>
-int run_scene(const nlohmann::json& scene_json, const std::string& source, const RunOptions& opt,
-              const RunOptions& given, const std::filesystem::path& out, bool resuming,
-              const std::function<void()>& start_output) {
-  Scene<Dim, Real> scene = load_scene<Dim, Real>(scene_json, source);
-  auto& cfg = scene.solver;
+void apply_solver_options(SolverConfig<Dim, Real>& cfg, const RunOptions& opt, const std::string& source) {
   if (!opt.method.empty()) {
     auto m = parse_method(opt.method);
     if (!m)
@@ -269,77 +272,348 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     cfg.backend = *parse_backend(opt.backend);  // checked by run_command
   else
     require_backend(cfg.backend, source + ": /solver/backend");  // the scene's, before anything is written
-  OutputSettings os = scene.output;
+}
+
+RunOutputSettings output_settings(OutputSettings os, const RunOptions& opt) {
+  RunOutputSettings s;
   if (opt.until > 0) os.end_time = opt.until;
   if (opt.fps > 0) os.fps = opt.fps;
-  OutputFormats formats;
   if (!opt.formats.empty()) {
-    formats = parse_output_formats(opt.formats, "--format");
+    s.formats = parse_output_formats(opt.formats, "--format");
   } else {
     std::string list;
     for (const auto& f : os.formats) list += (list.empty() ? "" : ",") + f;
-    formats = list.empty() ? OutputFormats{} : parse_output_formats(list, "output.formats");
+    s.formats = list.empty() ? OutputFormats{} : parse_output_formats(list, "output.formats");
   }
   if (!opt.color_by.empty()) os.color_by = opt.color_by;
-  RenderOptions ropt;
-  ropt.color_by = parse_color_by(os.color_by, "--color-by");
-  ropt.up_axis = os.up_axis;
-  SurfaceOptions sopt;
-  sopt.format = parse_surface_format(opt.surface_format);
-  sopt.threads = max_threads();
-  validate(sopt);
+  s.ropt.color_by = parse_color_by(os.color_by, "--color-by");
+  s.ropt.up_axis = os.up_axis;
+  s.sopt.format = parse_surface_format(opt.surface_format);
+  s.sopt.threads = max_threads();
+  validate(s.sopt);
+  s.os = std::move(os);
+  return s;
+}
 
-  Simulation<Dim, Real> sim(cfg, std::move(scene.particles));
-  const auto& parts = sim.particles();
-  auto is_fluid = [&parts](std::size_t i) {
-    return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid);
-  };
-  // Pictures show the floating bodies' particles too (the frames hold the fluid only; bodies.csv the bodies).
-  const auto& body_of = sim.body_of_slot();
-  ropt.visible = [&parts, &body_of](std::size_t i) {
-    return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) ||
-           (i < body_of.size() && body_of[i] >= 0);
-  };
-  RenderBox rbox;
-  rbox.lo = scene.view_lo;
-  rbox.hi = scene.view_hi;
-  FrameOutput<Dim, Real> frames(out, formats, is_fluid);  // writes nothing yet
+// Everything a run writes after run.json, and when: the frames at the output rate (particle files,
+// pictures, surfaces, a row of bodies.csv per floating body), probes.csv when the clock passes
+// k * probes_every, and checkpoint.bin every checkpoint_every frames, with the loop state it keeps.
+// Building it writes nothing, nor does a resume's reading of the checkpoint and the logs.
+template <int Dim, class Real>
+class RunOutputs {
+ public:
+  RunOutputs(Simulation<Dim, Real>& sim, const Scene<Dim, Real>& scene, RunOutputSettings settings,
+             const RunOptions& opt, const std::filesystem::path& out)
+      : sim_(sim),
+        opt_(opt),
+        set_(std::move(settings)),
+        out_(out),
+        png_dir_(out / "png"),
+        surface_dir_(out / "surface"),
+        ckpt_path_(out / kCheckpointFile),
+        frames_(out, set_.formats, fluid_rows(sim.particles())),
+        frame_dt_(1.0 / set_.os.fps),
+        probing_(!scene.probes.empty()),
+        sampler_(scene.probes, scene.solver.density_kernel, double(scene.solver.support),
+                 double(scene.spacing)),
+        probe_log_(out / "probes.csv", probe_columns(scene.probes, Dim)),
+        probes_every_(scene.probes_every),
+        floating_(!sim.body_states().empty()),
+        body_log_(out / "bodies.csv",
+                  {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"}) {
+    // Pictures show the floating bodies' particles too (the frames hold the fluid only; bodies.csv the
+    // bodies).
+    set_.ropt.visible = [&parts = sim.particles(), &body_of = sim.body_of_slot()](std::size_t i) {
+      return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) ||
+             (i < body_of.size() && body_of[i] >= 0);
+    };
+    rbox_.lo = scene.view_lo;
+    rbox_.hi = scene.view_hi;
+  }
 
-  LoopState loop;
-  const auto ckpt_path = out / kCheckpointFile;
-  if (resuming && !std::filesystem::exists(ckpt_path)) {
-    // Killed before its first checkpoint: the run is deterministic, so starting again from t = 0 gives
-    // exactly what continuing would have.
-    if (!opt.quiet)
-      std::fprintf(stderr, "cellsph: %s has no checkpoint yet; starting again from t = 0\n",
-                   out.string().c_str());
-    resuming = false;
+  // For --resume: the checkpoint's simulation and frame counter, and the rows of the frame index,
+  // probes.csv and bodies.csv up to its time; the probe schedule follows from the time alone. A run
+  // killed before its first checkpoint starts again from t = 0: it is deterministic, so that gives
+  // exactly what continuing would have.
+  void resume(bool quiet) {
+    if (!std::filesystem::exists(ckpt_path_)) {
+      if (!quiet)
+        std::fprintf(stderr, "cellsph: %s has no checkpoint yet; starting again from t = 0\n",
+                     out_.string().c_str());
+      return;
+    }
+    reject_old_checkpoint(ckpt_path_);
+    loop_.decode(read_simulation_checkpoint(ckpt_path_, sim_), ckpt_path_);
+    frames_.resume(loop_.next_frame);
+    // probes.csv keeps its rows up to the checkpoint's time: each was flushed before that checkpoint.
+    if (probing_) {
+      probe_log_.resume(double(sim_.time()));
+      while (probes_due()) ++next_probe_;
+    }
+    if (floating_) body_log_.resume(double(sim_.time()));
   }
-  if (resuming) {
-    reject_old_checkpoint(ckpt_path);
-    loop.decode(read_simulation_checkpoint(ckpt_path, sim), ckpt_path);
-    frames.resume(loop.next_frame);
+
+  // The folders of the pictures and surfaces asked for.
+  void make_folders() const {
+    if (opt_.render) make_folder(png_dir_);
+    if (opt_.surface) make_folder(surface_dir_);
   }
-  // Probes: sampled when the clock passes k * probes_every (one row per step at most); the count due
-  // follows from the time alone, so a resume continues the same schedule, and probes.csv keeps its
-  // rows up to the checkpoint's time (every one of them was flushed before that checkpoint).
-  const bool probing = !scene.probes.empty();
-  const ProbeSampler<Dim, Real> sampler(scene.probes, cfg.density_kernel, double(cfg.support),
-                                        double(scene.spacing));
-  ProbeLog probe_log(out / "probes.csv", probe_columns(scene.probes, Dim));
-  std::uint64_t next_probe = 0;
-  auto probes_due = [&] {
-    return probing && double(sim.time()) >= double(next_probe) * scene.probes_every * (1 - 1e-12);
+
+  // One row of probes.csv when the clock has passed the next sample time (one row per step at most).
+  void sample_probes() {
+    if (!probes_due()) return;
+    probe_log_.add(double(sim_.time()), sampler_.sample(sim_.particles()));
+    while (probes_due()) ++next_probe_;
+  }
+
+  // Every frame due at the current time: after a step, one or more (fps above 1 / dt); at the start,
+  // frame 0 of a new run, or on a resume those that a checkpoint taken between two frames of one step
+  // left unwritten (none in the common case).
+  void write_due_frames() {
+    while (double(sim_.time()) >= double(loop_.next_frame) * frame_dt_ * (1 - 1e-12)) write_frame();
+  }
+
+  void write_checkpoint() {
+    if (probing_) probe_log_.flush();
+    if (floating_) body_log_.flush();  // every row up to the checkpoint's time is on disk first
+    write_simulation_checkpoint(sim_, loop_.encode(), ckpt_path_);
+  }
+
+  // The end state too, so that a finished run can be extended with --resume DIR --until LATER.
+  void write_end_checkpoint() {
+    if (set_.os.checkpoint_every > 0) {
+      Stopwatch sw;
+      write_checkpoint();
+      output_ms_ += sw.ms();
+    }
+  }
+
+  void flush_probes() {
+    if (probing_) probe_log_.flush();
+  }
+
+  // The pictures as movie.mp4, where ffmpeg is installed; the message says which.
+  void write_movie() const {
+    const auto v = make_mp4(png_dir_, "frame_%05d.png", set_.os.fps, out_ / "movie.mp4");
+    std::fprintf(stderr, "cellsph: %s\n", v.message.c_str());
+  }
+
+  [[nodiscard]] const OutputSettings& settings() const { return set_.os; }
+  [[nodiscard]] std::uint64_t next_frame() const { return loop_.next_frame; }
+  [[nodiscard]] double output_ms() const { return output_ms_; }
+
+ private:
+  // The rows of the frames: the fluid particles.
+  static CsvRowFilter fluid_rows(const Particles<Dim, Real>& parts) {
+    return
+        [&p = parts](std::size_t i) { return p.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid); };
+  }
+
+  [[nodiscard]] bool probes_due() const {
+    return probing_ && double(sim_.time()) >= double(next_probe_) * probes_every_ * (1 - 1e-12);
+  }
+
+  void write_frame() {
+    Stopwatch sw;
+    const double t = double(sim_.time());
+    if (set_.formats.any()) frames_.write(sim_.particles(), loop_.next_frame, t);
+    if (opt_.render)
+      render_png(sim_.particles(), set_.ropt, rbox_, t, png_dir_ / frame_file_name(loop_.next_frame, "png"));
+    if (opt_.surface) write_surfaces(sim_.particles(), set_.sopt, surface_dir_, loop_.next_frame);
+    if (probing_) probe_log_.flush();
+    if (floating_) write_body_rows(t);
+    ++loop_.next_frame;
+    if (set_.os.checkpoint_every > 0 &&
+        loop_.next_frame % static_cast<std::uint64_t>(set_.os.checkpoint_every) == 0)
+      write_checkpoint();
+    output_ms_ += sw.ms();
+  }
+
+  void write_body_rows(double t) {
+    const auto& st = sim_.body_states();
+    for (std::size_t b = 0; b < st.size(); ++b) {
+      const auto& s = st[b];
+      body_log_.add(t, {double(b), s.x[0], s.x[1], s.x[2], s.q[0], s.q[1], s.q[2], s.q[3], s.v[0], s.v[1],
+                        s.v[2], s.w[0], s.w[1], s.w[2]});
+    }
+    body_log_.flush();
+  }
+
+  Simulation<Dim, Real>& sim_;
+  const RunOptions& opt_;
+  RunOutputSettings set_;
+  RenderBox rbox_;
+  std::filesystem::path out_, png_dir_, surface_dir_, ckpt_path_;
+  FrameOutput<Dim, Real> frames_;
+  LoopState loop_;
+  double frame_dt_;
+  double output_ms_ = 0;
+  bool probing_;
+  ProbeSampler<Dim, Real> sampler_;
+  ProbeLog probe_log_;
+  double probes_every_;
+  std::uint64_t next_probe_ = 0;
+  bool floating_;
+  ProbeLog body_log_;
+};
+
+// Where this invocation's stepping started: the progress line's rate and the summary count from here.
+struct RunStart {
+  Stopwatch wall;
+  std::uint64_t steps = 0;
+  double time = 0;
+};
+
+template <int Dim, class Real>
+void print_run_header(const Scene<Dim, Real>& scene, const std::string& source,
+                      const Simulation<Dim, Real>& sim, const std::filesystem::path& out) {
+  const auto& cfg = scene.solver;
+  std::fprintf(stderr, "cellsph: %s (%s): %zu particles (%zu fluid), %dD %s, %s, %s, %d threads -> %s\n",
+               scene.header.name.c_str(), source.c_str(), sim.particles().size(), sim.fluid_count(), Dim,
+               sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
+               std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
+}
+
+template <int Dim, class Real>
+std::string progress_line(const Simulation<Dim, Real>& sim, const RunStart& start, std::uint64_t next_frame,
+                          double end_time) {
+  const double w = start.wall.seconds();
+  return "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", end_time) + " s  frame " +
+         std::to_string(next_frame) + "  " +
+         fmt("%.0f", double(sim.steps() - start.steps) / std::max(w, 1e-9)) + " steps/s  " +
+         std::to_string(sim.fluid_count()) + " fluid particles" + dfsph_progress(sim);
+}
+
+// Steps until --steps or the end time, or until a stop signal, sampling the probes and writing the frames
+// as they fall due, with a progress line after each step.
+template <int Dim, class Real>
+void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs, Progress& progress,
+                     const RunStart& start, const RunOptions& opt) {
+  const double end_time = outputs.settings().end_time;
+  auto done = [&] {
+    if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
+    return double(sim.time()) >= end_time * (1 - 1e-12);
   };
-  if (resuming && probing) {
-    probe_log.resume(double(sim.time()));
-    while (probes_due()) ++next_probe;
+  std::uint64_t max_iteration_hits_seen = 0;
+  try {
+    outputs.sample_probes();
+    outputs.write_due_frames();
+    while (!done() && !g_stop_signal) {
+      sim.step();
+      warn_max_iterations(sim, progress, max_iteration_hits_seen);
+      outputs.sample_probes();
+      outputs.write_due_frames();
+      const double frac = opt.steps >= 0
+                              ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
+                              : (double(sim.time()) - start.time) / std::max(end_time - start.time, 1e-300);
+      progress.update(frac, progress_line(sim, start, outputs.next_frame(), end_time));
+    }
+  } catch (...) {
+    progress.finish();  // the error's line starts on a line of its own
+    throw;
   }
-  // Floating bodies: bodies.csv, one row per body and frame (the probe log's format and resume).
-  const bool floating = !sim.body_states().empty();
-  ProbeLog body_log(out / "bodies.csv",
-                    {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"});
-  if (resuming && floating) body_log.resume(double(sim.time()));
+  progress.finish();
+}
+
+// The summary's note on the last implicit solve stopped at max_iterations, if any.
+std::string last_hit_note(const DfsphStats& st) {
+  return st.max_iteration_hits ? " (last: step " + std::to_string(st.last_hit_step) + ", error " +
+                                     fmt("%.3g", st.last_hit_error) + "%)"
+                               : "";
+}
+
+template <int Dim, class Real>
+void print_iisph_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Real>& cfg) {
+  const auto& tm = sim.timings();
+  const auto& st = sim.dfsph_stats();
+  const double n = double(std::max<std::uint64_t>(st.steps, 1));
+  const double its = double(st.density_iterations);
+  std::fprintf(stderr,
+               "         iisph: %.2f iterations/step, density error last %.3g%% max %.3g%% (bound %.3g%%), "
+               "%llu solves stopped at max_iterations%s\n",
+               its / n, st.last_density_error, st.max_density_error, double(cfg.dfsph.max_density_error),
+               static_cast<unsigned long long>(st.max_iteration_hits), last_hit_note(st).c_str());
+  std::fprintf(stderr,
+               "         iisph ms/step: search %.3g, density+alpha %.3g, non-pressure forces %.3g, pressure "
+               "solve %.3g, drift %.3g (%.3g ms an iteration)\n",
+               tm.neighbors / n, st.ms_factor / n, st.ms_nonpressure / n, st.ms_density / n, st.ms_drift / n,
+               its > 0 ? st.ms_density / its : 0.0);
+}
+
+template <int Dim, class Real>
+void print_dfsph_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Real>& cfg) {
+  const auto& tm = sim.timings();
+  const auto& st = sim.dfsph_stats();
+  const double n = double(std::max<std::uint64_t>(st.steps, 1));
+  std::fprintf(stderr,
+               "         dfsph: %.2f density + %.2f divergence sweeps/step, density error last %.3g%% "
+               "max %.3g%% (bound %.3g%%), %llu solves stopped at max_iterations%s\n",
+               double(st.density_iterations) / n, double(st.divergence_iterations) / n, st.last_density_error,
+               st.max_density_error, double(cfg.dfsph.max_density_error),
+               static_cast<unsigned long long>(st.max_iteration_hits), last_hit_note(st).c_str());
+  // Where a step's time goes (Simulation::dfsph_stats), for docs/benchmarks.md. The non-pressure forces
+  // are summed in the divergence solve's last pass (models/dfsph.hpp): their time is the solve's.
+  const double sweeps = double(st.density_iterations);
+  std::fprintf(stderr,
+               "         dfsph ms/step: search %.3g, density+alpha %.3g, divergence solve + non-pressure "
+               "forces %.3g, kick %.3g, density solve %.3g, drift %.3g (%.3g ms a density sweep)\n",
+               tm.neighbors / n, st.ms_factor / n, st.ms_divergence / n, st.ms_nonpressure / n,
+               st.ms_density / n, st.ms_drift / n, sweeps > 0 ? st.ms_density / sweeps : 0.0);
+}
+
+// The summary: simulated time, wall time, steps and frames, where the time went, and the implicit
+// solvers' figures.
+template <int Dim, class Real>
+void print_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Real>& cfg,
+                   const RunStart& start, const RunOutputs<Dim, Real>& outputs,
+                   const std::filesystem::path& out) {
+  const double w = start.wall.seconds();
+  const auto& tm = sim.timings();
+  const std::uint64_t steps = sim.steps() - start.steps;
+  const double output_ms = outputs.output_ms();
+  const double total_ms = tm.neighbors + tm.forces + tm.integration + output_ms;
+  auto pct = [&](double ms) { return fmt("%.0f%%", 100.0 * ms / std::max(total_ms, 1e-9)); };
+  std::fprintf(
+      stderr,
+      "cellsph: done: simulated %.4g s in %s wall, %llu steps (mean dt %.3g s), %llu frames in %s\n"
+      "         time split: neighbours %s, forces %s, integration %s, output %s\n",
+      double(sim.time()), Progress::format_duration(w).c_str(), static_cast<unsigned long long>(steps),
+      steps ? (double(sim.time()) - start.time) / double(steps) : 0.0,
+      static_cast<unsigned long long>(outputs.next_frame()), out.string().c_str(), pct(tm.neighbors).c_str(),
+      pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
+  if (cfg.model == Model::Iisph) print_iisph_summary(sim, cfg);
+  if (cfg.model == Model::Dfsph) print_dfsph_summary(sim, cfg);
+}
+
+// Stopped between two steps: the state after the last step, with its frame counter, so the resume
+// continues exactly as the run would have (frames after the last one written follow on resume).
+template <int Dim, class Real>
+int stop_with_checkpoint(int sig, const Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
+                         const RunOptions& given, const std::filesystem::path& out) {
+  outputs.write_checkpoint();
+  std::fprintf(stderr,
+               "cellsph: stopped by %s at t = %.6g s, step %llu, after frame %llu, in %s; checkpoint "
+               "written\ncellsph: to continue: %s\n",
+               signal_name(sig), double(sim.time()), static_cast<unsigned long long>(sim.steps()),
+               static_cast<unsigned long long>(outputs.next_frame()) - 1, out.string().c_str(),
+               resume_command(given, out).c_str());
+  return 128 + sig;
+}
+
+// Runs one scene. Two phases: first everything is read, validated and built (scene, options,
+// particles, Simulation, the checkpoint and the frame index of a resume) without writing anything, so a
+// failed start leaves the output location as it was; then `start_output` makes the folder and run.json,
+// and the frames follow.
+template <int Dim, class Real>
+int run_scene(const nlohmann::json& scene_json, const std::string& source, const RunOptions& opt,
+              const RunOptions& given, const std::filesystem::path& out, bool resuming,
+              const std::function<void()>& start_output) {
+  Scene<Dim, Real> scene = load_scene<Dim, Real>(scene_json, source);
+  apply_solver_options(scene.solver, opt, source);
+  RunOutputSettings settings = output_settings(scene.output, opt);
+  Simulation<Dim, Real> sim(scene.solver, std::move(scene.particles));
+  RunOutputs<Dim, Real> outputs(sim, scene, std::move(settings), opt, out);  // writes nothing yet
+  if (resuming) outputs.resume(opt.quiet);
 
   // ---- Everything is valid: from here on the run writes.
   if (g_stop_signal) {
@@ -348,225 +622,54 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
     return 128 + g_stop_signal;
   }
   start_output();
-  const auto png_dir = out / "png";
-  const auto surface_dir = out / "surface";
-  if (opt.render) make_folder(png_dir);
-  if (opt.surface) make_folder(surface_dir);
+  outputs.make_folders();
 
   Progress progress(opt.quiet);
-  Stopwatch wall;
-  double output_ms = 0;
-  const std::uint64_t steps_at_start = sim.steps();
-  const double t_at_start = double(sim.time());
-  const double frame_dt = 1.0 / os.fps;
-
-  auto sample_probes = [&] {
-    if (!probes_due()) return;
-    probe_log.add(double(sim.time()), sampler.sample(sim.particles()));
-    while (probes_due()) ++next_probe;
-  };
-  auto write_checkpoint = [&] {
-    if (probing) probe_log.flush();
-    if (floating) body_log.flush();  // every row up to the checkpoint's time is on disk first
-    write_simulation_checkpoint(sim, loop.encode(), ckpt_path);
-  };
-  auto write_frame = [&] {
-    Stopwatch sw;
-    const double t = double(sim.time());
-    if (formats.any()) frames.write(sim.particles(), loop.next_frame, t);
-    if (opt.render)
-      render_png(sim.particles(), ropt, rbox, t, png_dir / frame_file_name(loop.next_frame, "png"));
-    if (opt.surface) write_surfaces(sim.particles(), sopt, surface_dir, loop.next_frame);
-    if (probing) probe_log.flush();
-    if (floating) {
-      const auto& st = sim.body_states();
-      for (std::size_t b = 0; b < st.size(); ++b) {
-        const auto& s = st[b];
-        body_log.add(t, {double(b), s.x[0], s.x[1], s.x[2], s.q[0], s.q[1], s.q[2], s.q[3], s.v[0], s.v[1],
-                         s.v[2], s.w[0], s.w[1], s.w[2]});
-      }
-      body_log.flush();
-    }
-    ++loop.next_frame;
-    if (os.checkpoint_every > 0 && loop.next_frame % static_cast<std::uint64_t>(os.checkpoint_every) == 0)
-      write_checkpoint();
-    output_ms += sw.ms();
-  };
-  // Every frame due at the current time: after a step, one or more (fps above 1 / dt); at the start,
-  // frame 0 of a new run, or on a resume those that a checkpoint taken between two frames of one step
-  // left unwritten (none in the common case).
-  auto write_due_frames = [&] {
-    while (double(sim.time()) >= double(loop.next_frame) * frame_dt * (1 - 1e-12)) write_frame();
-  };
-
-  if (!opt.quiet)
-    std::fprintf(stderr, "cellsph: %s (%s): %zu particles (%zu fluid), %dD %s, %s, %s, %d threads -> %s\n",
-                 scene.header.name.c_str(), source.c_str(), sim.particles().size(), sim.fluid_count(), Dim,
-                 sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
-                 std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
-
-  auto done = [&] {
-    if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
-    return double(sim.time()) >= os.end_time * (1 - 1e-12);
-  };
-  std::uint64_t max_iteration_hits_seen = 0;
-  try {
-    sample_probes();
-    write_due_frames();
-    while (!done() && !g_stop_signal) {
-      sim.step();
-      warn_max_iterations(sim, progress, max_iteration_hits_seen);
-      sample_probes();
-      write_due_frames();
-      const double frac =
-          opt.steps >= 0 ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
-                         : (double(sim.time()) - t_at_start) / std::max(os.end_time - t_at_start, 1e-300);
-      const double w = wall.seconds();
-      progress.update(frac, "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", os.end_time) +
-                                " s  frame " + std::to_string(loop.next_frame) + "  " +
-                                fmt("%.0f", double(sim.steps() - steps_at_start) / std::max(w, 1e-9)) +
-                                " steps/s  " + std::to_string(sim.fluid_count()) + " fluid particles" +
-                                dfsph_progress(sim));
-    }
-  } catch (...) {
-    progress.finish();  // the error's line starts on a line of its own
-    throw;
-  }
-  progress.finish();
-  if (probing) probe_log.flush();
-  if (const int sig = g_stop_signal) {
-    // Stopped between two steps: the state after the last step, with its frame counter, so the resume
-    // continues exactly as the run would have (frames after the last one written follow on resume).
-    write_checkpoint();
-    std::fprintf(stderr,
-                 "cellsph: stopped by %s at t = %.6g s, step %llu, after frame %llu, in %s; checkpoint "
-                 "written\ncellsph: to continue: %s\n",
-                 signal_name(sig), double(sim.time()), static_cast<unsigned long long>(sim.steps()),
-                 static_cast<unsigned long long>(loop.next_frame) - 1, out.string().c_str(),
-                 resume_command(given, out).c_str());
-    return 128 + sig;
-  }
-  // The end state too, so that a finished run can be extended with --resume DIR --until LATER.
-  if (os.checkpoint_every > 0) {
-    Stopwatch sw;
-    write_checkpoint();
-    output_ms += sw.ms();
-  }
-
-  if (opt.render && !opt.quiet) {
-    const auto v = make_mp4(png_dir, "frame_%05d.png", os.fps, out / "movie.mp4");
-    std::fprintf(stderr, "cellsph: %s\n", v.message.c_str());
-  }
-
-  if (!opt.quiet) {
-    const double w = wall.seconds();
-    const auto& tm = sim.timings();
-    const std::uint64_t steps = sim.steps() - steps_at_start;
-    const double total_ms = tm.neighbors + tm.forces + tm.integration + output_ms;
-    auto pct = [&](double ms) { return fmt("%.0f%%", 100.0 * ms / std::max(total_ms, 1e-9)); };
-    std::fprintf(
-        stderr,
-        "cellsph: done: simulated %.4g s in %s wall, %llu steps (mean dt %.3g s), %llu frames in %s\n"
-        "         time split: neighbours %s, forces %s, integration %s, output %s\n",
-        double(sim.time()), Progress::format_duration(w).c_str(), static_cast<unsigned long long>(steps),
-        steps ? (double(sim.time()) - t_at_start) / double(steps) : 0.0,
-        static_cast<unsigned long long>(loop.next_frame), out.string().c_str(), pct(tm.neighbors).c_str(),
-        pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
-    if (cfg.model == Model::Iisph) {
-      const auto& st = sim.dfsph_stats();
-      const double n = double(std::max<std::uint64_t>(st.steps, 1));
-      const double its = double(st.density_iterations);
-      std::fprintf(
-          stderr,
-          "         iisph: %.2f iterations/step, density error last %.3g%% max %.3g%% (bound %.3g%%), "
-          "%llu solves stopped at max_iterations%s\n",
-          its / n, st.last_density_error, st.max_density_error, double(cfg.dfsph.max_density_error),
-          static_cast<unsigned long long>(st.max_iteration_hits),
-          st.max_iteration_hits ? (" (last: step " + std::to_string(st.last_hit_step) + ", error " +
-                                   fmt("%.3g", st.last_hit_error) + "%)")
-                                      .c_str()
-                                : "");
-      std::fprintf(
-          stderr,
-          "         iisph ms/step: search %.3g, density+alpha %.3g, non-pressure forces %.3g, pressure "
-          "solve %.3g, drift %.3g (%.3g ms an iteration)\n",
-          tm.neighbors / n, st.ms_factor / n, st.ms_nonpressure / n, st.ms_density / n, st.ms_drift / n,
-          its > 0 ? st.ms_density / its : 0.0);
-    }
-    if (cfg.model == Model::Dfsph) {
-      const auto& st = sim.dfsph_stats();
-      const double n = double(std::max<std::uint64_t>(st.steps, 1));
-      std::fprintf(stderr,
-                   "         dfsph: %.2f density + %.2f divergence sweeps/step, density error last %.3g%% "
-                   "max %.3g%% (bound %.3g%%), %llu solves stopped at max_iterations%s\n",
-                   double(st.density_iterations) / n, double(st.divergence_iterations) / n,
-                   st.last_density_error, st.max_density_error, double(cfg.dfsph.max_density_error),
-                   static_cast<unsigned long long>(st.max_iteration_hits),
-                   st.max_iteration_hits ? (" (last: step " + std::to_string(st.last_hit_step) + ", error " +
-                                            fmt("%.3g", st.last_hit_error) + "%)")
-                                               .c_str()
-                                         : "");
-      // Where a step's time goes (Simulation::dfsph_stats), for docs/benchmarks.md. The non-pressure forces
-      // are summed in the divergence solve's last pass (models/dfsph.hpp): their time is the solve's.
-      const double sweeps = double(st.density_iterations);
-      std::fprintf(stderr,
-                   "         dfsph ms/step: search %.3g, density+alpha %.3g, divergence solve + non-pressure "
-                   "forces %.3g, kick %.3g, density solve %.3g, drift %.3g (%.3g ms a density sweep)\n",
-                   tm.neighbors / n, st.ms_factor / n, st.ms_divergence / n, st.ms_nonpressure / n,
-                   st.ms_density / n, st.ms_drift / n, sweeps > 0 ? st.ms_density / sweeps : 0.0);
-    }
-  }
+  const RunStart start{Stopwatch{}, sim.steps(), double(sim.time())};
+  if (!opt.quiet) print_run_header(scene, source, sim, out);
+  step_until_done(sim, outputs, progress, start, opt);
+  outputs.flush_probes();
+  if (const int sig = g_stop_signal) return stop_with_checkpoint(sig, sim, outputs, given, out);
+  outputs.write_end_checkpoint();
+  if (opt.render && !opt.quiet) outputs.write_movie();
+  if (!opt.quiet) print_summary(sim, scene.solver, start, outputs, out);
   return 0;
 }
 
-int run_command(RunOptions opt) {
-  // From the start, so that a Ctrl-C while the scene loads still ends with code 130 and nothing written.
-  install_stop_handlers();
-  const RunOptions given = opt;
-  nlohmann::json scene_json;
-  std::string source;
-  std::filesystem::path out;
-  bool resuming = false;
-  if (!opt.resume.empty()) {
-    // Resume: the scene and the options of the original run come from DIR/run.json.
-    out = opt.resume;
-    const auto run_file = out / kRunFile;
-    if (!std::filesystem::exists(run_file))
-      throw InputError("--resume " + out.string() + ": no " + kRunFile +
-                       " there (not a cellsph output folder)");
-    const auto saved = JsonReader::parse_file(run_file);
-    try {
-      scene_json = saved.at("scene");
-      source = saved.at("source").get<std::string>();
-      const auto& o = saved.at("options");
-      if (opt.method.empty()) opt.method = o.at("method").get<std::string>();
-      // A checkpoint does not depend on the backend: a resume may pick another one.
-      if (opt.backend.empty() && o.contains("backend")) opt.backend = o.at("backend").get<std::string>();
-      if (opt.fps <= 0) opt.fps = o.at("fps").get<double>();
-      if (opt.formats.empty()) opt.formats = o.at("formats").get<std::string>();
-      if (opt.until <= 0) opt.until = o.at("until").get<double>();
-      if (opt.steps < 0) opt.steps = o.at("steps").get<long>();
-      if (!opt.render) opt.render = o.at("render").get<bool>();
-      if (opt.color_by.empty()) opt.color_by = o.at("color_by").get<std::string>();
-      if (!opt.surface) opt.surface = o.at("surface").get<bool>();
-      if (o.contains("surface_format")) opt.surface_format = o.at("surface_format").get<std::string>();
-    } catch (const nlohmann::json::exception& e) {
-      throw InputError(run_file.string() + ": damaged (" + e.what() + ")");
-    }
-    resuming = true;
-    if (!opt.sets.empty())
-      throw InputError("--set: not with --resume (a resumed run keeps the scene saved in " +
-                       run_file.string() + ")");
-  } else {
-    if (opt.scene.empty()) opt.scene = kDefaultScene;
-    scene_json = read_scene_json(opt.scene, source);
-    apply_scene_edits(scene_json, opt.sets, source);
+// For --resume: the scene and the options of the original run, from DIR/run.json (an option given again
+// on this command line keeps the new value).
+void load_saved_run(RunOptions& opt, nlohmann::json& scene_json, std::string& source) {
+  const std::filesystem::path out = opt.resume;
+  const auto run_file = out / kRunFile;
+  if (!std::filesystem::exists(run_file))
+    throw InputError("--resume " + out.string() + ": no " + kRunFile +
+                     " there (not a cellsph output folder)");
+  const auto saved = JsonReader::parse_file(run_file);
+  try {
+    scene_json = saved.at("scene");
+    source = saved.at("source").get<std::string>();
+    const auto& o = saved.at("options");
+    if (opt.method.empty()) opt.method = o.at("method").get<std::string>();
+    // A checkpoint does not depend on the backend: a resume may pick another one.
+    if (opt.backend.empty() && o.contains("backend")) opt.backend = o.at("backend").get<std::string>();
+    if (opt.fps <= 0) opt.fps = o.at("fps").get<double>();
+    if (opt.formats.empty()) opt.formats = o.at("formats").get<std::string>();
+    if (opt.until <= 0) opt.until = o.at("until").get<double>();
+    if (opt.steps < 0) opt.steps = o.at("steps").get<long>();
+    if (!opt.render) opt.render = o.at("render").get<bool>();
+    if (opt.color_by.empty()) opt.color_by = o.at("color_by").get<std::string>();
+    if (!opt.surface) opt.surface = o.at("surface").get<bool>();
+    if (o.contains("surface_format")) opt.surface_format = o.at("surface_format").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(run_file.string() + ": damaged (" + e.what() + ")");
   }
-  const SceneHeader header = read_scene_header(scene_json, source);
-  if (out.empty())
-    out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
+  if (!opt.sets.empty())
+    throw InputError("--set: not with --resume (a resumed run keeps the scene saved in " + run_file.string() +
+                     ")");
+}
 
-  // Option errors come before the scene is built.
+// Option errors come before the scene is built.
+void check_options(const RunOptions& opt) {
   parse_surface_format(opt.surface_format);
   if (!opt.method.empty() && !parse_method(opt.method))
     throw InputError("--method: unknown method '" + opt.method + "' (expected " + method_names_joined() +
@@ -578,34 +681,61 @@ int run_command(RunOptions opt) {
     require_backend(*b, "--backend");  // before anything is written: no build, device or driver
   }
   if (!opt.color_by.empty()) parse_color_by(opt.color_by, "--color-by");
+}
 
-  // Called by run_scene once everything is valid: the first writes of the run.
+// The first writes of a run, once everything is valid. What writers killed in this folder before left is
+// removed (a run killed mid-write, then resumed or started again into the same folder); a new run makes
+// the folder and run.json, the scene and options a resume reads back.
+void start_output(const std::filesystem::path& out, bool new_run, const nlohmann::json& scene_json,
+                  const std::string& source, const RunOptions& opt) {
+  for (const auto& d : {out, out / "png", out / "surface"}) remove_stale_temporaries(d);
+  if (!new_run) return;
+  make_folder(out);
+  nlohmann::json saved;
+  saved["scene"] = scene_json;
+  saved["source"] = source;
+  saved["options"] = {{"method", opt.method},   {"backend", opt.backend},
+                      {"fps", opt.fps},         {"formats", opt.formats},
+                      {"until", opt.until},     {"steps", opt.steps},
+                      {"render", opt.render},   {"color_by", opt.color_by},
+                      {"surface", opt.surface}, {"surface_format", opt.surface_format}};
+  write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
+}
+
+int run_command(RunOptions opt) {
+  // From the start, so that a Ctrl-C while the scene loads still ends with code 130 and nothing written.
+  install_stop_handlers();
+  const RunOptions given = opt;
+  nlohmann::json scene_json;
+  std::string source;
+  std::filesystem::path out;
+  bool resuming = false;
+  if (!opt.resume.empty()) {
+    out = opt.resume;
+    load_saved_run(opt, scene_json, source);
+    resuming = true;
+  } else {
+    if (opt.scene.empty()) opt.scene = kDefaultScene;
+    scene_json = read_scene_json(opt.scene, source);
+    apply_scene_edits(scene_json, opt.sets, source);
+  }
+  const SceneHeader header = read_scene_header(scene_json, source);
+  if (out.empty())
+    out = opt.out.empty() ? std::filesystem::path(header.name) : std::filesystem::path(opt.out);
+  check_options(opt);
+
+  // Called by run_scene once everything is valid.
   const bool new_run = opt.resume.empty();
-  auto start_output = [&] {
-    // What writers killed in this folder before left (a run killed mid-write, then resumed or started
-    // again into the same folder).
-    for (const auto& d : {out, out / "png", out / "surface"}) remove_stale_temporaries(d);
-    if (!new_run) return;
-    make_folder(out);
-    nlohmann::json saved;
-    saved["scene"] = scene_json;
-    saved["source"] = source;
-    saved["options"] = {{"method", opt.method},   {"backend", opt.backend},
-                        {"fps", opt.fps},         {"formats", opt.formats},
-                        {"until", opt.until},     {"steps", opt.steps},
-                        {"render", opt.render},   {"color_by", opt.color_by},
-                        {"surface", opt.surface}, {"surface_format", opt.surface_format}};
-    write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
-  };
+  auto first_writes = [&] { start_output(out, new_run, scene_json, source, opt); };
 
   ScopedThreads threads(opt.threads);
   if (header.dim == 2)
     return header.single_precision
-               ? run_scene<2, float>(scene_json, source, opt, given, out, resuming, start_output)
-               : run_scene<2, double>(scene_json, source, opt, given, out, resuming, start_output);
+               ? run_scene<2, float>(scene_json, source, opt, given, out, resuming, first_writes)
+               : run_scene<2, double>(scene_json, source, opt, given, out, resuming, first_writes);
   return header.single_precision
-             ? run_scene<3, float>(scene_json, source, opt, given, out, resuming, start_output)
-             : run_scene<3, double>(scene_json, source, opt, given, out, resuming, start_output);
+             ? run_scene<3, float>(scene_json, source, opt, given, out, resuming, first_writes)
+             : run_scene<3, double>(scene_json, source, opt, given, out, resuming, first_writes);
 }
 
 }  // namespace

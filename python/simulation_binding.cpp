@@ -434,9 +434,8 @@ class PySimulation {
   std::unique_ptr<SimBase> sim_;
 };
 
-}  // namespace
-
-void register_simulation(py::module_& m) {
+// Scene and scenes().
+void register_scene(py::module_& m) {
   using namespace pybind11::literals;
 
   py::class_<PyScene>(m, "Scene",
@@ -496,24 +495,14 @@ Every error is a ValueError with the message of the command line (file or source
         return l;
       },
       "The names of the built-in scenes.");
+}
 
-  auto field_prop = [](const char* name) {
-    return [name](const PySimulation& s) { return s.locked([&](SimBase& b) { return b.field(name); }); };
-  };
-  py::class_<PySimulation>(m, "Simulation",
-                           R"doc(A running simulation of a Scene (the solver of `cellsph run`).
-
-    sim = cellsph.Simulation(scene, threads=2)
-    sim.run_until(0.5)                  # steps as `cellsph run --until 0.5`
-    x = sim.positions                   # (n, dim) copy, in id order
-
-The same scene and thread count give the same bits as `cellsph run`. Particle fields are copies in id order
-(row k is the particle with id k, for every field and every call), fluid and boundary particles together
-(`kind`: 0 fluid, 1 boundary). The GIL is released while the solver steps.)doc")
-      .def(py::init<const PyScene&, int, const std::string&>(), "scene"_a, "threads"_a = 0,
-           "backend"_a = "cpu",
-           "threads: OpenMP threads for every call (0 = all cores). backend: 'cpu' or 'cuda' (RuntimeError "
-           "when this build has no CUDA backend or finds no usable device; docs/gpu.md).")
+// Simulation's constructors, its stepping and its outputs.
+void def_simulation_steps(py::class_<PySimulation>& c) {
+  using namespace pybind11::literals;
+  c.def(py::init<const PyScene&, int, const std::string&>(), "scene"_a, "threads"_a = 0, "backend"_a = "cpu",
+        "threads: OpenMP threads for every call (0 = all cores). backend: 'cpu' or 'cuda' (RuntimeError "
+        "when this build has no CUDA backend or finds no usable device; docs/gpu.md).")
       .def_static("resume", &PySimulation::resume, "A simulation from a file written by checkpoint().",
                   "path"_a, "threads"_a = 0, "backend"_a = "cpu")
       .def("step", &PySimulation::step, "Advances `count` time steps.", "count"_a = 1)
@@ -534,10 +523,14 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
       .def("checkpoint", &PySimulation::checkpoint,
            "Writes the whole state (every particle field, the integrator state and the scene) to `path`, "
            "atomically; Simulation.resume(path) continues bit for bit.",
-           "path"_a)
-      .def_property_readonly(
-          "time", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.time(); }); },
-          "Simulated time [s].")
+           "path"_a);
+}
+
+// Simulation's clock, thread count, scene and particle counts.
+void def_simulation_state(py::class_<PySimulation>& c) {
+  c.def_property_readonly(
+       "time", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.time(); }); },
+       "Simulated time [s].")
       .def_property_readonly(
           "steps", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.steps(); }); },
           "Steps taken.")
@@ -557,8 +550,15 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
       .def_property_readonly(
           "fluid_count",
           [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.fluid_count(); }); },
-          "Fluid particles (kind 0).")
-      .def_property_readonly("positions", field_prop("position"), "(n, dim) positions [m], copy in id order.")
+          "Fluid particles (kind 0).");
+}
+
+// Simulation's particle fields (copies in id order), timings and solver statistics.
+void def_simulation_fields(py::class_<PySimulation>& c) {
+  auto field_prop = [](const char* name) {
+    return [name](const PySimulation& s) { return s.locked([&](SimBase& b) { return b.field(name); }); };
+  };
+  c.def_property_readonly("positions", field_prop("position"), "(n, dim) positions [m], copy in id order.")
       .def_property_readonly(
           "velocities", field_prop("velocity"),
           "(n, dim) velocities [m/s], copy in id order (the paper model holds v(t - dt/2)).")
@@ -586,6 +586,25 @@ The same scene and thread count give the same bits as `cellsph run`. Particle fi
           "bound "
           "(max_iteration_hits; last_max_iteration_hit: its step, solve, iterations, error_percent, "
           "bound_percent, or None). None for the explicit models.");
+}
+
+}  // namespace
+
+void register_simulation(py::module_& m) {
+  register_scene(m);
+  py::class_<PySimulation> c(m, "Simulation",
+                             R"doc(A running simulation of a Scene (the solver of `cellsph run`).
+
+    sim = cellsph.Simulation(scene, threads=2)
+    sim.run_until(0.5)                  # steps as `cellsph run --until 0.5`
+    x = sim.positions                   # (n, dim) copy, in id order
+
+The same scene and thread count give the same bits as `cellsph run`. Particle fields are copies in id order
+(row k is the particle with id k, for every field and every call), fluid and boundary particles together
+(`kind`: 0 fluid, 1 boundary). The GIL is released while the solver steps.)doc");
+  def_simulation_steps(c);
+  def_simulation_state(c);
+  def_simulation_fields(c);
 }
 
 }  // namespace cellsph::python

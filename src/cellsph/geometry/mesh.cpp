@@ -180,6 +180,76 @@ void check_ply(std::string_view b, const std::string& label) {
     }
 }
 
+#ifndef CELLSPH_NO_ASSIMP
+// Reads `bytes` from memory with the extension as the hint: only that format's reader runs, and an OBJ
+// file's "mtllib" cannot make Assimp open other files (there are none in its memory file system).
+const aiScene* import_scene(Assimp::Importer& importer, std::string_view bytes, const std::string& ext,
+                            const std::string& label) {
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  const aiScene* scene = nullptr;
+  try {
+    // No aiProcess_Triangulate: Debian's Assimp 5.2.5 aborts in it (an ai_assert) on some polygon
+    // lists (fuzz/regressions/mesh/assimp-triangulate-abort); polygons are split by add_faces, as fans.
+    scene =
+        importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure, ext.c_str());
+  } catch (const std::exception& e) {
+    fail(label, std::string("cannot be read as ") + ext + ": " + e.what());
+  }
+  if (!scene) {
+    std::string why = importer.GetErrorString();
+    while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+    fail(label, "cannot be read as " + ext + " (Assimp: " + (why.empty() ? "no reason given" : why) + ")");
+  }
+  return scene;
+}
+
+// A vertex position as Assimp holds it: equal positions are one vertex of the welded mesh.
+struct VertexKey {
+  float x, y, z;
+  bool operator==(const VertexKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct VertexKeyHash {
+  std::size_t operator()(const VertexKey& k) const {
+    std::uint32_t b[3];
+    std::memcpy(b, &k, sizeof b);
+    return (std::size_t{b[0]} * 0x9E3779B1u) ^ (std::size_t{b[1]} * 0x85EBCA77u) ^
+           (std::size_t{b[2]} * 0xC2B2AE3Du) ^ (std::size_t{b[2]} << 32);
+  }
+};
+using WeldIndex = std::unordered_map<VertexKey, std::uint32_t, VertexKeyHash>;
+
+// Adds the faces of one of Assimp's meshes to `m`: a polygon of n vertices as the fan of n - 2 triangles
+// from its first vertex, on vertices welded by position (`index`: each position's vertex in `m`). Returns
+// the faces that are points or lines.
+std::size_t add_faces(const aiMesh& am, TriangleMesh& m, WeldIndex& index, const std::string& label) {
+  std::size_t lines_or_points = 0;
+  std::vector<std::uint32_t> local(am.mNumVertices, std::numeric_limits<std::uint32_t>::max());
+  auto vertex = [&](unsigned v) -> std::uint32_t {
+    if (v >= am.mNumVertices)
+      fail(label, "a face refers to vertex " + std::to_string(v) + " of " + std::to_string(am.mNumVertices));
+    if (local[v] != std::numeric_limits<std::uint32_t>::max()) return local[v];
+    const aiVector3D& a = am.mVertices[v];
+    if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(a.z))
+      fail(label, "vertex " + std::to_string(v + 1) + " has a coordinate that is not a finite number");
+    const VertexKey k{a.x + 0.0f, a.y + 0.0f, a.z + 0.0f};  // + 0: -0 and 0 are one vertex
+    auto [it, added] = index.try_emplace(k, static_cast<std::uint32_t>(m.vertices.size()));
+    if (added) m.vertices.push_back({double(a.x), double(a.y), double(a.z)});
+    return local[v] = it->second;
+  };
+  if (am.mNumFaces > 0 && !am.mFaces) fail(label, "a mesh has faces but no face list");
+  for (unsigned f = 0; f < am.mNumFaces; ++f) {
+    const aiFace& face = am.mFaces[f];
+    if (face.mNumIndices < 3 || !face.mIndices) {
+      ++lines_or_points;
+      continue;
+    }
+    const std::uint32_t first = vertex(face.mIndices[0]);
+    for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+      m.triangles.push_back({first, vertex(face.mIndices[k]), vertex(face.mIndices[k + 1])});
+  }
+  return lines_or_points;
+}
+#endif
 }  // namespace
 
 TriangleMesh read_mesh_file(const std::filesystem::path& file, const std::string& label) {
@@ -213,69 +283,13 @@ TriangleMesh parse_mesh(std::string_view bytes, std::string_view extension, cons
   fail(label, "cannot be read: this build of cellsph has no mesh reader (built without Assimp)");
 #else
   Assimp::Importer importer;
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
-  // From memory with the extension as the hint: only that format's reader runs, and an OBJ file's
-  // "mtllib" cannot make Assimp open other files (there are none in its memory file system).
-  const aiScene* scene = nullptr;
-  try {
-    // No aiProcess_Triangulate: Debian's Assimp 5.2.5 aborts in it (an ai_assert) on some polygon
-    // lists (fuzz/regressions/mesh/assimp-triangulate-abort); polygons are split below, as fans.
-    scene =
-        importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_ValidateDataStructure, ext.c_str());
-  } catch (const std::exception& e) {
-    fail(label, std::string("cannot be read as ") + ext + ": " + e.what());
-  }
-  if (!scene) {
-    std::string why = importer.GetErrorString();
-    while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
-    fail(label, "cannot be read as " + ext + " (Assimp: " + (why.empty() ? "no reason given" : why) + ")");
-  }
-
+  const aiScene* scene = import_scene(importer, bytes, ext, label);
+  // The meshes of the file as one: their triangles on vertices welded across them.
   TriangleMesh m;
-  struct Key {
-    float x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      std::uint32_t b[3];
-      std::memcpy(b, &k, sizeof b);
-      return (std::size_t{b[0]} * 0x9E3779B1u) ^ (std::size_t{b[1]} * 0x85EBCA77u) ^
-             (std::size_t{b[2]} * 0xC2B2AE3Du) ^ (std::size_t{b[2]} << 32);
-    }
-  };
-  std::unordered_map<Key, std::uint32_t, KeyHash> index;
+  WeldIndex index;
   std::size_t lines_or_points = 0;
-  for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
-    const aiMesh* am = scene->mMeshes[mi];
-    if (!am) continue;
-    std::vector<std::uint32_t> local(am->mNumVertices, std::numeric_limits<std::uint32_t>::max());
-    auto vertex = [&](unsigned v) -> std::uint32_t {
-      if (v >= am->mNumVertices)
-        fail(label,
-             "a face refers to vertex " + std::to_string(v) + " of " + std::to_string(am->mNumVertices));
-      if (local[v] != std::numeric_limits<std::uint32_t>::max()) return local[v];
-      const aiVector3D& a = am->mVertices[v];
-      if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(a.z))
-        fail(label, "vertex " + std::to_string(v + 1) + " has a coordinate that is not a finite number");
-      const Key k{a.x + 0.0f, a.y + 0.0f, a.z + 0.0f};  // + 0: -0 and 0 are one vertex
-      auto [it, added] = index.try_emplace(k, static_cast<std::uint32_t>(m.vertices.size()));
-      if (added) m.vertices.push_back({double(a.x), double(a.y), double(a.z)});
-      return local[v] = it->second;
-    };
-    if (am->mNumFaces > 0 && !am->mFaces) fail(label, "a mesh has faces but no face list");
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices < 3 || !face.mIndices) {
-        ++lines_or_points;
-        continue;
-      }
-      // A polygon of n vertices: the fan of n - 2 triangles from its first vertex.
-      const std::uint32_t first = vertex(face.mIndices[0]);
-      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
-        m.triangles.push_back({first, vertex(face.mIndices[k]), vertex(face.mIndices[k + 1])});
-    }
-  }
+  for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
+    if (const aiMesh* am = scene->mMeshes[mi]) lines_or_points += add_faces(*am, m, index, label);
   if (m.triangles.empty())
     fail(label, lines_or_points ? "has only points or lines, no triangles (a closed surface is needed)"
                                 : "has no triangles");

@@ -217,34 +217,23 @@ void write_checkpoint_any(const P& particles, const CheckpointInfo& info, const 
   write_file_atomic(path, out);
 }
 
-template <class P>
-CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particles) {
-  using namespace io::detail;
-  using V = typename P::V;
-  constexpr int Dim = V::dim;
-  using Real = typename V::scalar;
-  const std::string bytes = read_all(path);
-  if (bytes.size() < sizeof(std::uint64_t) + sizeof(kMagic)) {
-    Cursor c(path, bytes, bytes.size());
-    parse_header(c);  // reports bad magic or truncation
-  }
-  // The checksum is the last 8 bytes: everything before it is the body.
-  const std::size_t body = bytes.size() - sizeof(std::uint64_t);
-  Cursor c(path, bytes, body);
-  const CheckpointHeader h = parse_header(c);
+namespace io::detail {
+
+// The header's dimension and precision must be the run's.
+template <int Dim, class Real>
+void check_same_kind_of_run(const Cursor& c, const CheckpointHeader& h) {
   if (h.dim != Dim)
     c.fail("written by a " + std::to_string(h.dim) + "D run, cannot continue a " + std::to_string(Dim) +
            "D run");
   if (h.real_size != static_cast<int>(sizeof(Real)))
     c.fail(std::string("precision mismatch: file holds ") + precision_name(h.real_size) + " (" +
            std::to_string(h.real_size) + " bytes), this run uses " + precision_name(sizeof(Real)));
-  CheckpointInfo info;
-  info.time = h.time;
-  info.step = h.step;
-  const auto user_len = c.get<std::uint64_t>("the user data length");
-  info.user = std::string(c.get_bytes(user_len, "the user data"));
+}
 
-  // Before allocating: a corrupt count must not ask for more memory than the file could fill.
+// Before allocating: a corrupt count must not ask for more memory than the file (up to `body`, where the
+// checksum starts) could fill.
+template <class P>
+void check_count_fits(const Cursor& c, const P& particles, const CheckpointHeader& h, std::size_t body) {
   std::size_t per_particle = 0;
   particles.for_each_field([&](std::string_view name, const auto& field) {
     if constexpr (requires { particles.absent_before(name, h.version); })
@@ -254,8 +243,38 @@ CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particl
   if (per_particle && h.count > (body - c.pos()) / per_particle)
     c.fail("truncated or corrupt: " + std::to_string(h.count) +
            " particles need more bytes than the file has");
-  P loaded;
-  loaded.resize(static_cast<std::size_t>(h.count));
+}
+
+// One field's element size, count and data, after its name, into the field of `loaded` of that name.
+template <class P>
+void read_field(Cursor& c, P& loaded, const std::string& name, const CheckpointHeader& h, std::size_t body) {
+  const auto elem_size = c.get<std::uint32_t>("the element size of field '" + name + "'");
+  const auto count = c.get<std::uint64_t>("the element count of field '" + name + "'");
+  bool found = false;
+  loaded.for_each_field([&](std::string_view fname, auto& field) {
+    if (fname != name) return;
+    found = true;
+    using T = typename std::remove_cvref_t<decltype(field)>::value_type;
+    if (elem_size != sizeof(T))
+      c.fail("field '" + name + "' has elements of " + std::to_string(elem_size) + " bytes, expected " +
+             std::to_string(sizeof(T)));
+    if (count != h.count)
+      c.fail("field '" + name + "' has " + std::to_string(count) + " elements for " +
+             std::to_string(h.count) + " particles");
+    if (count > (body - c.pos()) / sizeof(T))  // checked by division: a corrupt count must not overflow
+      c.fail("truncated: file ends at byte " + std::to_string(body) + " inside the data of field '" + name +
+             "'");
+    const auto data =
+        c.get_bytes(static_cast<std::size_t>(count) * sizeof(T), "the data of field '" + name + "'");
+    if (count) std::memcpy(field.data(), data.data(), data.size());
+  });
+  CELLSPH_CHECK(found, name);
+}
+
+// The field count and the fields, into `loaded` (sized to the header's count). Each field of `loaded` must
+// be there once, unless the file's version predates it; no other field may be.
+template <class P>
+void read_fields(Cursor& c, P& loaded, const CheckpointHeader& h, std::size_t body) {
   std::set<std::string, std::less<>> known, seen;
   loaded.for_each_field([&](std::string_view name, const auto&) { known.emplace(name); });
   const auto nfields = c.get<std::uint32_t>("the field count");
@@ -266,27 +285,7 @@ CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particl
     if (!known.count(name))
       c.fail("unknown field '" + name + "' (" + what + "); this build does not have it");
     if (!seen.insert(name).second) c.fail("field '" + name + "' appears twice");
-    const auto elem_size = c.get<std::uint32_t>("the element size of field '" + name + "'");
-    const auto count = c.get<std::uint64_t>("the element count of field '" + name + "'");
-    bool found = false;
-    loaded.for_each_field([&](std::string_view fname, auto& field) {
-      if (fname != name) return;
-      found = true;
-      using T = typename std::remove_cvref_t<decltype(field)>::value_type;
-      if (elem_size != sizeof(T))
-        c.fail("field '" + name + "' has elements of " + std::to_string(elem_size) + " bytes, expected " +
-               std::to_string(sizeof(T)));
-      if (count != h.count)
-        c.fail("field '" + name + "' has " + std::to_string(count) + " elements for " +
-               std::to_string(h.count) + " particles");
-      if (count > (body - c.pos()) / sizeof(T))  // checked by division: a corrupt count must not overflow
-        c.fail("truncated: file ends at byte " + std::to_string(body) + " inside the data of field '" + name +
-               "'");
-      const auto data =
-          c.get_bytes(static_cast<std::size_t>(count) * sizeof(T), "the data of field '" + name + "'");
-      if (count) std::memcpy(field.data(), data.data(), data.size());
-    });
-    CELLSPH_CHECK(found, name);
+    read_field(c, loaded, name, h, body);
   }
   for (const auto& name : known) {
     if (seen.count(name)) continue;
@@ -294,6 +293,34 @@ CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particl
       if (loaded.absent_before(name, h.version)) continue;  // 0, as resize left it
     c.fail("missing field '" + name + "'");
   }
+}
+
+}  // namespace io::detail
+
+template <class P>
+CheckpointInfo read_checkpoint_any(const std::filesystem::path& path, P& particles) {
+  using namespace io::detail;
+  using V = typename P::V;
+  const std::string bytes = read_all(path);
+  if (bytes.size() < sizeof(std::uint64_t) + sizeof(kMagic)) {
+    Cursor c(path, bytes, bytes.size());
+    parse_header(c);  // reports bad magic or truncation
+  }
+  // The checksum is the last 8 bytes: everything before it is the body.
+  const std::size_t body = bytes.size() - sizeof(std::uint64_t);
+  Cursor c(path, bytes, body);
+  const CheckpointHeader h = parse_header(c);
+  check_same_kind_of_run<V::dim, typename V::scalar>(c, h);
+  CheckpointInfo info;
+  info.time = h.time;
+  info.step = h.step;
+  const auto user_len = c.get<std::uint64_t>("the user data length");
+  info.user = std::string(c.get_bytes(user_len, "the user data"));
+
+  check_count_fits(c, particles, h, body);
+  P loaded;
+  loaded.resize(static_cast<std::size_t>(h.count));
+  read_fields(c, loaded, h, body);
   if (c.pos() != body)
     c.fail(std::to_string(body - c.pos()) +
            " unexpected bytes after the last field (corrupted or wrong format)");

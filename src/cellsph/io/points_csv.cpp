@@ -81,18 +81,13 @@ double parse_field(std::string_view raw, const Column& col, std::string_view sou
   return value;
 }
 
-}  // namespace
-
-PointsTable parse_points_csv(std::string_view text, std::string_view source) {
-  // A UTF-8 byte-order mark is not part of the first column's name.
-  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
-  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
-    throw InputError("points file '" + std::string(source) +
-                     "' is empty (expected a header row naming columns x,y or x,y,z)");
-
+// The lines of a text, each without its '\n' or "\r\n", numbered from 1.
+struct Lines {
+  std::string_view text;
   std::size_t pos = 0;
   std::size_t line_no = 0;
-  auto next_line = [&](std::string_view& line) {
+
+  bool next(std::string_view& line) {
     if (pos >= text.size()) return false;
     const auto nl = text.find('\n', pos);
     const auto end = nl == std::string_view::npos ? text.size() : nl;
@@ -101,16 +96,15 @@ PointsTable parse_points_csv(std::string_view text, std::string_view source) {
     pos = end + 1;
     ++line_no;
     return true;
-  };
+  }
+  // The text after the lines read so far.
+  [[nodiscard]] std::string_view rest() const {
+    return pos < text.size() ? text.substr(pos) : std::string_view{};
+  }
+};
 
-  // Header: leading blank lines are not allowed to hide it.
-  std::string_view header;
-  next_line(header);
-  if (trim(header).empty())
-    throw InputError(where(source, line_no) +
-                     ": expected the header row (x,y or x,y,z), found an empty line");
-
-  PointsTable t;
+// The header's fields, trimmed.
+std::vector<std::string_view> column_names(std::string_view header) {
   std::vector<std::string_view> names;
   for (std::size_t b = 0;;) {
     const auto c = header.find(',', b);
@@ -118,46 +112,59 @@ PointsTable parse_points_csv(std::string_view text, std::string_view source) {
     if (c == std::string_view::npos) break;
     b = c + 1;
   }
-  const std::size_t n_fields = names.size();
+  return names;
+}
 
-  auto find_column = [&](std::string_view name) -> std::ptrdiff_t {
-    std::ptrdiff_t found = -1;
-    for (std::size_t k = 0; k < n_fields; ++k) {
-      if (names[k] != name) continue;
-      if (found >= 0)
-        throw InputError(where(source, 1) + ": column '" + std::string(name) + "' appears twice (columns " +
-                         std::to_string(found + 1) + " and " + std::to_string(k + 1) + ")");
-      found = static_cast<std::ptrdiff_t>(k);
-    }
-    return found;
-  };
-  const std::ptrdiff_t ix = find_column("x"), iy = find_column("y"), iz = find_column("z"),
-                       ih = find_column("h");
+// The position of column `name` in the header, or -1; a name that appears twice is an error.
+std::ptrdiff_t find_column(const std::vector<std::string_view>& names, std::string_view name,
+                           std::string_view source) {
+  std::ptrdiff_t found = -1;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    if (names[k] != name) continue;
+    if (found >= 0)
+      throw InputError(where(source, 1) + ": column '" + std::string(name) + "' appears twice (columns " +
+                       std::to_string(found + 1) + " and " + std::to_string(k + 1) + ")");
+    found = static_cast<std::ptrdiff_t>(k);
+  }
+  return found;
+}
+
+// The columns the table is read from: x and y, then z and h where the header has them, each filling its
+// vector of `t`. Sets t.dim.
+std::vector<Column> table_columns(const std::vector<std::string_view>& names, std::string_view header,
+                                  PointsTable& t, std::string_view source) {
+  const std::ptrdiff_t ix = find_column(names, "x", source), iy = find_column(names, "y", source),
+                       iz = find_column(names, "z", source), ih = find_column(names, "h", source);
   for (auto [idx, name] : {std::pair{ix, "x"}, std::pair{iy, "y"}})
     if (idx < 0)
       throw InputError(where(source, 1) + ": missing column '" + name + "' (header: " + shown(header) +
                        "; expected x,y or x,y,z, optionally h)");
   t.dim = iz >= 0 ? 3 : 2;
-
   std::vector<Column> cols;
   cols.push_back({"x", static_cast<std::size_t>(ix), &t.coord[0], false});
   cols.push_back({"y", static_cast<std::size_t>(iy), &t.coord[1], false});
   if (iz >= 0) cols.push_back({"z", static_cast<std::size_t>(iz), &t.coord[2], false});
   if (ih >= 0) cols.push_back({"h", static_cast<std::size_t>(ih), &t.h, true});
+  return cols;
+}
+
+// The rows after the header, each of n_fields fields, the columns' fields parsed into their vectors. Blank
+// lines may only end the file.
+void read_rows(Lines& lines, const std::vector<Column>& cols, std::size_t n_fields, std::string_view source) {
   // column position -> needed column (or none), so each row is split in one pass.
   std::vector<const Column*> by_position(n_fields, nullptr);
   for (const auto& c : cols) by_position[c.index] = &c;
 
-  // Rows. Reserve from a cheap line count so 10^6 rows do not reallocate.
-  const std::string_view rest = pos < text.size() ? text.substr(pos) : std::string_view{};
+  // Reserve from a cheap line count so 10^6 rows do not reallocate.
+  const std::string_view rest = lines.rest();
   const auto approx_rows = static_cast<std::size_t>(std::count(rest.begin(), rest.end(), '\n')) + 1;
   for (const auto& c : cols) c.target->reserve(approx_rows);
 
   std::size_t blank_line = 0;  // first blank line seen; only allowed at the end of the file
   std::string_view line;
-  while (next_line(line)) {
+  while (lines.next(line)) {
     if (trim(line).empty()) {
-      if (blank_line == 0) blank_line = line_no;
+      if (blank_line == 0) blank_line = lines.line_no;
       continue;
     }
     if (blank_line != 0)
@@ -169,15 +176,37 @@ PointsTable parse_points_csv(std::string_view text, std::string_view source) {
       const auto e = c == std::string_view::npos ? line.size() : c;
       if (field < n_fields && by_position[field] != nullptr) {
         const Column& col = *by_position[field];
-        col.target->push_back(parse_field(line.substr(b, e - b), col, source, line_no));
+        col.target->push_back(parse_field(line.substr(b, e - b), col, source, lines.line_no));
       }
       if (c == std::string_view::npos) break;
       b = c + 1;
     }
     if (field + 1 != n_fields)
-      throw InputError(where(source, line_no) + ": row has " + std::to_string(field + 1) +
+      throw InputError(where(source, lines.line_no) + ": row has " + std::to_string(field + 1) +
                        " field(s), the header has " + std::to_string(n_fields) + ": " + shown(line));
   }
+}
+}  // namespace
+
+PointsTable parse_points_csv(std::string_view text, std::string_view source) {
+  // A UTF-8 byte-order mark is not part of the first column's name.
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
+    throw InputError("points file '" + std::string(source) +
+                     "' is empty (expected a header row naming columns x,y or x,y,z)");
+
+  Lines lines{text};
+  // Header: leading blank lines are not allowed to hide it.
+  std::string_view header;
+  lines.next(header);
+  if (trim(header).empty())
+    throw InputError(where(source, lines.line_no) +
+                     ": expected the header row (x,y or x,y,z), found an empty line");
+
+  PointsTable t;
+  const std::vector<std::string_view> names = column_names(header);
+  const std::vector<Column> cols = table_columns(names, header, t, source);
+  read_rows(lines, cols, names.size(), source);
   if (t.size() == 0)
     throw InputError("points file '" + std::string(source) + "' has a header but no data rows");
   // Indices are 32-bit in the neighbour lists.

@@ -259,70 +259,71 @@ struct ViewAndScale {
   double world_per_pixel = 0;  // at the target depth, final resolution
 };
 
-ViewAndScale make_view(int dim, const RenderOptions& o, const RenderBox& box, const Layout& l) {
-  const int ss = o.supersample;
-  const V3 lo = to_v3(box.lo), hi = to_v3(box.hi);
-  V3 centre = 0.5 * (lo + hi);
-  const double plot_w = l.right - l.left, plot_h = l.bottom - l.top;
-  ViewAndScale r;
+// 2D: a parallel projection along -z that fits the box into the plot area.
+void fit_view_2d(ViewAndScale& r, V3 lo, V3 hi, double plot_w, double plot_h, int ss) {
   View& v = r.view;
-  v.cx = ss * (l.left + plot_w / 2);
-  v.cy = ss * (l.top + plot_h / 2);
-  if (dim == 2) {
-    centre.z = 0;
-    v.ortho = true;
-    v.fwd = {0, 0, -1};
-    v.up = {0, 1, 0};
-    v.right = cross(v.fwd, v.up);
-    v.eye = centre + V3{0, 0, 1};
-    const double bw = std::max(hi.x - lo.x, 1e-30), bh = std::max(hi.y - lo.y, 1e-30);
-    const double scale = 0.96 * std::min(plot_w / bw, plot_h / bh);  // pixels per metre, final resolution
-    v.focal = ss * scale;
-    r.world_per_pixel = 1 / scale;
-    return r;
-  }
-  const V3 diag = hi - lo;
-  const double radius = std::max(0.5 * std::sqrt(dot(diag, diag)), 1e-30);
+  V3 centre = 0.5 * (lo + hi);
+  centre.z = 0;
+  v.ortho = true;
+  v.fwd = {0, 0, -1};
+  v.up = {0, 1, 0};
+  v.right = cross(v.fwd, v.up);
+  v.eye = centre + V3{0, 0, 1};
+  const double bw = std::max(hi.x - lo.x, 1e-30), bh = std::max(hi.y - lo.y, 1e-30);
+  const double scale = 0.96 * std::min(plot_w / bw, plot_h / bh);  // pixels per metre, final resolution
+  v.focal = ss * scale;
+  r.world_per_pixel = 1 / scale;
+}
+
+// 3D without a camera of the options': a perspective camera looking at the box's centre from a fixed
+// direction (above and in front for either up axis), at the closest distance at which all eight box
+// corners project into the plot area (bisection; the bounding sphere's distance always fits). (cx, cy):
+// the plot area's centre on the supersampled screen.
+Camera fitted_camera(const RenderOptions& o, V3 lo, V3 hi, double radius, const Layout& l, double cx,
+                     double cy) {
+  const int ss = o.supersample;
+  const V3 centre = 0.5 * (lo + hi);
+  const double plot_w = l.right - l.left, plot_h = l.bottom - l.top;
   Camera cam;
-  const bool fitted = !o.camera.has_value();
-  if (o.camera) {
-    cam = *o.camera;
-    v.cx = ss * o.width / 2.0;  // an explicit camera looks through the image centre
-    v.cy = ss * o.height / 2.0;
-  } else {
-    cam.target = {centre.x, centre.y, centre.z};
-    V3 dir = o.up_axis == 2 ? V3{0.55, -1.0, 0.5} : V3{0.55, 0.5, 1.0};
-    cam.up = o.up_axis == 2 ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{0, 1, 0};
-    // Closest distance at which all eight box corners project into the plot area (bisection; the
-    // bounding sphere's distance always fits).
-    const double focal = ss * (o.height / 2.0) / std::tan(cam.fov_y_deg * kPi / 360);
-    View probe;
-    probe.fwd = -1.0 * normalized(dir);
-    probe.right = normalized(cross(probe.fwd, to_v3(cam.up)));
-    probe.up = cross(probe.right, probe.fwd);
-    probe.focal = focal;
-    probe.cx = v.cx;
-    probe.cy = v.cy;
-    auto fits = [&](double dist) {
-      probe.eye = centre + dist * normalized(dir);
-      for (int i = 0; i < 8; ++i) {
-        const V3 c{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z};
-        double sx, sy;
-        if (!probe.project(probe.to_view(c), sx, sy)) return false;
-        if (sx < ss * (l.left + 0.02 * plot_w) || sx > ss * (l.right - 0.02 * plot_w) ||
-            sy < ss * (l.top + 0.02 * plot_h) || sy > ss * (l.bottom - 0.02 * plot_h))
-          return false;
-      }
-      return true;
-    };
-    double far = radius / std::sin(std::atan(std::min(plot_w, plot_h) / 2 * ss / focal)), close = radius;
-    for (int it = 0; it < 40; ++it) {
-      const double mid = 0.5 * (close + far);
-      (fits(mid) ? far : close) = mid;
+  cam.target = {centre.x, centre.y, centre.z};
+  V3 dir = o.up_axis == 2 ? V3{0.55, -1.0, 0.5} : V3{0.55, 0.5, 1.0};
+  cam.up = o.up_axis == 2 ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{0, 1, 0};
+  const double focal = ss * (o.height / 2.0) / std::tan(cam.fov_y_deg * kPi / 360);
+  View probe;
+  probe.fwd = -1.0 * normalized(dir);
+  probe.right = normalized(cross(probe.fwd, to_v3(cam.up)));
+  probe.up = cross(probe.right, probe.fwd);
+  probe.focal = focal;
+  probe.cx = cx;
+  probe.cy = cy;
+  auto fits = [&](double dist) {
+    probe.eye = centre + dist * normalized(dir);
+    for (int i = 0; i < 8; ++i) {
+      const V3 c{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z};
+      double sx, sy;
+      if (!probe.project(probe.to_view(c), sx, sy)) return false;
+      if (sx < ss * (l.left + 0.02 * plot_w) || sx > ss * (l.right - 0.02 * plot_w) ||
+          sy < ss * (l.top + 0.02 * plot_h) || sy > ss * (l.bottom - 0.02 * plot_h))
+        return false;
     }
-    const V3 eye = centre + far * normalized(dir);
-    cam.position = {eye.x, eye.y, eye.z};
+    return true;
+  };
+  double far = radius / std::sin(std::atan(std::min(plot_w, plot_h) / 2 * ss / focal)), close = radius;
+  for (int it = 0; it < 40; ++it) {
+    const double mid = 0.5 * (close + far);
+    (fits(mid) ? far : close) = mid;
   }
+  const V3 eye = centre + far * normalized(dir);
+  cam.position = {eye.x, eye.y, eye.z};
+  return cam;
+}
+
+// Looks through `cam` (each fault of it an InputError saying which) and sets the scale: an orthographic
+// camera's height, or where it has none, the bounding sphere's diameter times `fit` (with a margin); a
+// perspective camera's field of view.
+void look_through(ViewAndScale& r, const Camera& cam, const RenderOptions& o, double radius, double fit) {
+  const int ss = o.supersample;
+  View& v = r.view;
   v.eye = to_v3(cam.position);
   v.fwd = normalized(to_v3(cam.target) - v.eye);
   if (!(dot(v.fwd, v.fwd) > 0)) throw InputError("render camera: position equals target");
@@ -339,7 +340,7 @@ ViewAndScale make_view(int dim, const RenderOptions& o, const RenderBox& box, co
   const double target_dist = std::sqrt(dot(to_v3(cam.target) - v.eye, to_v3(cam.target) - v.eye));
   if (v.ortho) {
     double height = cam.ortho_height;
-    if (!(height > 0)) height = 2 * radius * (fitted ? o.height / std::min(plot_w, plot_h) : 1.0) * 1.02;
+    if (!(height > 0)) height = 2 * radius * fit * 1.02;
     const double scale = o.height / height;
     v.focal = ss * scale;
     r.world_per_pixel = 1 / scale;
@@ -347,6 +348,30 @@ ViewAndScale make_view(int dim, const RenderOptions& o, const RenderBox& box, co
     const double focal = (o.height / 2.0) / std::tan(cam.fov_y_deg * kPi / 360);
     v.focal = ss * focal;
     r.world_per_pixel = target_dist / focal;
+  }
+}
+
+ViewAndScale make_view(int dim, const RenderOptions& o, const RenderBox& box, const Layout& l) {
+  const int ss = o.supersample;
+  const V3 lo = to_v3(box.lo), hi = to_v3(box.hi);
+  const double plot_w = l.right - l.left, plot_h = l.bottom - l.top;
+  ViewAndScale r;
+  View& v = r.view;
+  v.cx = ss * (l.left + plot_w / 2);
+  v.cy = ss * (l.top + plot_h / 2);
+  if (dim == 2) {
+    fit_view_2d(r, lo, hi, plot_w, plot_h, ss);
+    return r;
+  }
+  const V3 diag = hi - lo;
+  const double radius = std::max(0.5 * std::sqrt(dot(diag, diag)), 1e-30);
+  if (o.camera) {
+    v.cx = ss * o.width / 2.0;  // an explicit camera looks through the image centre
+    v.cy = ss * o.height / 2.0;
+    look_through(r, *o.camera, o, radius, 1.0);
+  } else {
+    look_through(r, fitted_camera(o, lo, hi, radius, l, v.cx, v.cy), o, radius,
+                 o.height / std::min(plot_w, plot_h));
   }
   return r;
 }
@@ -372,6 +397,131 @@ void draw_label(Image& img, int x, int y, const std::string& text, int font, Rgb
   img.fill_rect(x - font, y - font, x + text_width(text, font) + font, y + text_height(font) + font, bg,
                 0.75);
   draw_text(img, x, y, text, kInk, font);
+}
+
+// The range the colour map spans (the visible particles' finite values, or the options' bounds) and the
+// phases the visible particles hold.
+struct ColourRange {
+  double vmin = 0, vmax = 0, span = 1;
+  std::set<int> phases;
+};
+
+void draw_box_outline(FrameBuffer& fb, const View& view, int dim, const RenderBox& box, double thickness) {
+  std::vector<std::pair<V3, V3>> edges;
+  box_edges(dim, box, edges);
+  const V3 diag = to_v3(box.hi) - to_v3(box.lo);
+  const double bias = 1e-3 * std::sqrt(dot(diag, diag));
+  for (const auto& [a, b] : edges) draw_segment(fb, view, a, b, thickness, {70, 70, 70}, dim == 3, bias);
+}
+
+// A bar of a round length at the bottom left; `at_target`: the length holds at the target's depth only.
+void draw_scale_bar(Image& img, const RenderOptions& o, const Layout& layout, double world_per_pixel,
+                    bool at_target) {
+  const int f = layout.font, m = layout.margin, th = text_height(f);
+  const double len = nice_length(world_per_pixel * o.width / 6);
+  const int px = static_cast<int>(std::lround(len / world_per_pixel));
+  const int y = o.height - m - 2 * f;
+  img.fill_rect(m, y, m + px, y + 2 * f, kInk);
+  img.fill_rect(m, y - 3 * f, m + f, y + 2 * f, kInk);
+  img.fill_rect(m + px - f, y - 3 * f, m + px, y + 2 * f, kInk);
+  const std::string label = format("%g", len) + " m" + (at_target ? " at target" : "");
+  draw_label(img, m + 2 * f, y - 4 * f - th, label, f, o.background);
+}
+
+// At the top right: the colour of each phase shown (at most 8), or the colour bar with its range.
+void draw_legend(Image& img, const RenderOptions& o, const Layout& layout, const ColourRange& range) {
+  const int f = layout.font, m = layout.margin, th = text_height(f);
+  const int x = o.width - m - 13 * kGlyphAdvance * f - 16 * f;
+  int y = m;
+  if (o.color_by == ColorBy::Phase) {
+    int shown = 0;
+    for (const int ph : range.phases) {
+      if (++shown > 8) break;
+      img.fill_rect(x, y, x + th, y + th, phase_colour(ph));
+      draw_text(img, x + th + 4 * f, y, "phase " + std::to_string(ph), kInk, f);
+      y += th + 4 * f;
+    }
+    return;
+  }
+  draw_text(img, x, y, o.color_by == ColorBy::Speed ? "speed [m/s]" : "pressure [Pa]", kInk, f);
+  y += th + 4 * f;
+  const int bar_h = o.height / 3, bar_w = 12 * f;
+  for (int j = 0; j < bar_h; ++j) {
+    const Rgb8 c = colormap(1.0 - static_cast<double>(j) / std::max(1, bar_h - 1));
+    img.fill_rect(x, y + j, x + bar_w, y + j + 1, c);
+  }
+  draw_text(img, x + bar_w + 4 * f, y, format("%.3g", range.vmax), kInk, f);
+  draw_text(img, x + bar_w + 4 * f, y + bar_h - th, format("%.3g", range.vmin), kInk, f);
+}
+
+void check_render_options(const RenderOptions& o) {
+  if (!(o.width > 0 && o.height > 0 && o.width <= 16384 && o.height <= 16384))
+    throw InputError("render image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                     " is outside 1..16384");
+  if (!(o.supersample >= 1 && o.supersample <= 4))
+    throw InputError("render supersample " + std::to_string(o.supersample) + " is outside 1..4");
+  if (o.up_axis != 1 && o.up_axis != 2)
+    throw InputError("render up axis " + std::to_string(o.up_axis) + " must be 1 (y) or 2 (z)");
+}
+
+// The scalar particle i is coloured by (0 when colouring by phase).
+template <int Dim, class Real>
+double colour_value(const Particles<Dim, Real>& p, const RenderOptions& o, std::size_t i) {
+  if (o.color_by == ColorBy::Speed) return std::sqrt(static_cast<double>(norm2(p.v[i])));
+  if (o.color_by == ColorBy::Pressure) return static_cast<double>(p.p[i]);
+  return 0;
+}
+
+template <int Dim, class Real>
+ColourRange colour_range(const Particles<Dim, Real>& p, const RenderOptions& o) {
+  const auto n = p.size();
+  double vmin = std::numeric_limits<double>::infinity(), vmax = -vmin;
+  ColourRange r;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (o.visible && !o.visible(i)) continue;
+    r.phases.insert(p.phase[i]);
+    const double v = colour_value(p, o, i);
+    if (std::isfinite(v)) {
+      vmin = std::min(vmin, v);
+      vmax = std::max(vmax, v);
+    }
+  }
+  if (o.range_min) vmin = *o.range_min;
+  if (o.range_max) vmax = *o.range_max;
+  if (!std::isfinite(vmin) || !std::isfinite(vmax)) vmin = vmax = 0;
+  r.vmin = vmin;
+  r.vmax = vmax;
+  r.span = vmax > vmin ? vmax - vmin : 1;
+  return r;
+}
+
+// One disc per visible particle: its radius the options' or half its volume's edge (else a quarter of h,
+// else a 400th of the box's diagonal), its colour its phase's or the colour map's.
+template <int Dim, class Real>
+std::vector<Sprite> make_sprites(const Particles<Dim, Real>& p, const RenderOptions& o, const RenderBox& box,
+                                 const ColourRange& range) {
+  const auto n = p.size();
+  const V3 diag = to_v3(box.hi) - to_v3(box.lo);
+  const double fallback_radius = std::sqrt(dot(diag, diag)) / 400;
+  std::vector<Sprite> sprites;
+  sprites.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (o.visible && !o.visible(i)) continue;
+    Sprite s;
+    s.centre = {static_cast<double>(p.x[i][0]), static_cast<double>(p.x[i][1]),
+                Dim == 3 ? static_cast<double>(p.x[i][Dim - 1]) : 0.0};
+    double r = o.particle_radius;
+    if (!(r > 0)) {
+      const double m = static_cast<double>(p.m[i]), rho = static_cast<double>(p.rho[i]);
+      r = m > 0 && rho > 0 ? 0.5 * std::pow(m / rho, 1.0 / Dim)
+                           : (p.h[i] > 0 ? static_cast<double>(p.h[i]) / 4 : fallback_radius);
+    }
+    s.radius = r;
+    s.colour = o.color_by == ColorBy::Phase ? phase_colour(p.phase[i])
+                                            : colormap((colour_value(p, o, i) - range.vmin) / range.span);
+    sprites.push_back(s);
+  }
+  return sprites;
 }
 
 }  // namespace
@@ -406,110 +556,29 @@ Rgb8 colormap(double t) {
 
 template <int Dim, class Real>
 Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const RenderBox& box, double time) {
-  if (!(o.width > 0 && o.height > 0 && o.width <= 16384 && o.height <= 16384))
-    throw InputError("render image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
-                     " is outside 1..16384");
-  if (!(o.supersample >= 1 && o.supersample <= 4))
-    throw InputError("render supersample " + std::to_string(o.supersample) + " is outside 1..4");
-  if (o.up_axis != 1 && o.up_axis != 2)
-    throw InputError("render up axis " + std::to_string(o.up_axis) + " must be 1 (y) or 2 (z)");
+  check_render_options(o);
   const int ss = o.supersample;
   const Layout layout = make_layout(o);
   const ViewAndScale vs = make_view(Dim, o, box, layout);
 
-  // The scalar to colour by, and its range.
   const auto n = p.size();
   CELLSPH_CHECK(p.v.size() == n && p.p.size() == n && p.m.size() == n && p.rho.size() == n &&
                     p.h.size() == n && p.phase.size() == n,
                 "particle fields of unequal length");
-  auto value = [&](std::size_t i) -> double {
-    if (o.color_by == ColorBy::Speed) return std::sqrt(static_cast<double>(norm2(p.v[i])));
-    if (o.color_by == ColorBy::Pressure) return static_cast<double>(p.p[i]);
-    return 0;
-  };
-  double vmin = std::numeric_limits<double>::infinity(), vmax = -vmin;
-  std::set<int> phases;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (o.visible && !o.visible(i)) continue;
-    phases.insert(p.phase[i]);
-    const double v = value(i);
-    if (std::isfinite(v)) {
-      vmin = std::min(vmin, v);
-      vmax = std::max(vmax, v);
-    }
-  }
-  if (o.range_min) vmin = *o.range_min;
-  if (o.range_max) vmax = *o.range_max;
-  if (!std::isfinite(vmin) || !std::isfinite(vmax)) vmin = vmax = 0;
-  const double span = vmax > vmin ? vmax - vmin : 1;
-
-  const V3 diag = to_v3(box.hi) - to_v3(box.lo);
-  const double fallback_radius = std::sqrt(dot(diag, diag)) / 400;
-  std::vector<Sprite> sprites;
-  sprites.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (o.visible && !o.visible(i)) continue;
-    Sprite s;
-    s.centre = {static_cast<double>(p.x[i][0]), static_cast<double>(p.x[i][1]),
-                Dim == 3 ? static_cast<double>(p.x[i][Dim - 1]) : 0.0};
-    double r = o.particle_radius;
-    if (!(r > 0)) {
-      const double m = static_cast<double>(p.m[i]), rho = static_cast<double>(p.rho[i]);
-      r = m > 0 && rho > 0 ? 0.5 * std::pow(m / rho, 1.0 / Dim)
-                           : (p.h[i] > 0 ? static_cast<double>(p.h[i]) / 4 : fallback_radius);
-    }
-    s.radius = r;
-    s.colour = o.color_by == ColorBy::Phase ? phase_colour(p.phase[i]) : colormap((value(i) - vmin) / span);
-    sprites.push_back(s);
-  }
+  const ColourRange range = colour_range(p, o);
+  const std::vector<Sprite> sprites = make_sprites(p, o, box, range);
 
   FrameBuffer fb(o.width * ss, o.height * ss, o.background);
   shade_sprites(fb, vs.view, sprites);
-  if (o.box_outline) {
-    std::vector<std::pair<V3, V3>> edges;
-    box_edges(Dim, box, edges);
-    const double bias = 1e-3 * std::sqrt(dot(diag, diag));
-    for (const auto& [a, b] : edges)
-      draw_segment(fb, vs.view, a, b, ss * std::max(2.0, 1.1 * layout.font), {70, 70, 70}, Dim == 3, bias);
-  }
+  if (o.box_outline) draw_box_outline(fb, vs.view, Dim, box, ss * std::max(2.0, 1.1 * layout.font));
   Image img = downsample(fb, ss);
 
   // Overlays at final resolution.
-  const int f = layout.font, m = layout.margin, th = text_height(f);
+  const int f = layout.font, m = layout.margin;
   if (o.time_label) draw_label(img, m, m, "t = " + format("%.3f", time) + " s", f, o.background);
-  if (o.scale_bar && vs.world_per_pixel > 0) {
-    const double len = nice_length(vs.world_per_pixel * o.width / 6);
-    const int px = static_cast<int>(std::lround(len / vs.world_per_pixel));
-    const int y = o.height - m - 2 * f;
-    img.fill_rect(m, y, m + px, y + 2 * f, kInk);
-    img.fill_rect(m, y - 3 * f, m + f, y + 2 * f, kInk);
-    img.fill_rect(m + px - f, y - 3 * f, m + px, y + 2 * f, kInk);
-    const std::string label = format("%g", len) + " m" + (Dim == 3 && !vs.view.ortho ? " at target" : "");
-    draw_label(img, m + 2 * f, y - 4 * f - th, label, f, o.background);
-  }
-  if (o.legend) {
-    const int x = o.width - m - 13 * kGlyphAdvance * f - 16 * f;
-    int y = m;
-    if (o.color_by == ColorBy::Phase) {
-      int shown = 0;
-      for (const int ph : phases) {
-        if (++shown > 8) break;
-        img.fill_rect(x, y, x + th, y + th, phase_colour(ph));
-        draw_text(img, x + th + 4 * f, y, "phase " + std::to_string(ph), kInk, f);
-        y += th + 4 * f;
-      }
-    } else {
-      draw_text(img, x, y, o.color_by == ColorBy::Speed ? "speed [m/s]" : "pressure [Pa]", kInk, f);
-      y += th + 4 * f;
-      const int bar_h = o.height / 3, bar_w = 12 * f;
-      for (int j = 0; j < bar_h; ++j) {
-        const Rgb8 c = colormap(1.0 - static_cast<double>(j) / std::max(1, bar_h - 1));
-        img.fill_rect(x, y + j, x + bar_w, y + j + 1, c);
-      }
-      draw_text(img, x + bar_w + 4 * f, y, format("%.3g", vmax), kInk, f);
-      draw_text(img, x + bar_w + 4 * f, y + bar_h - th, format("%.3g", vmin), kInk, f);
-    }
-  }
+  if (o.scale_bar && vs.world_per_pixel > 0)
+    draw_scale_bar(img, o, layout, vs.world_per_pixel, Dim == 3 && !vs.view.ortho);
+  if (o.legend) draw_legend(img, o, layout, range);
   return img;
 }
 
