@@ -115,26 +115,6 @@ void reject_old_checkpoint(const std::filesystem::path& file) {
                      "run the scene again");
 }
 
-// DFSPH's part of the progress line: sweeps of the last step (density / divergence), its average
-// density error and step; IISPH's: its iterations, error and step.
-template <int Dim, class Real>
-std::string dfsph_progress(const Simulation<Dim, Real>& sim) {
-  const Model model = sim.config().model;
-  if (!implicit_pressure(model)) return "";
-  const auto& st = sim.dfsph_stats();
-  char buf[160];
-  if (model == Model::Iisph)
-    std::snprintf(buf, sizeof buf, "  iisph %d iterations, err %.3f%%, dt %.3g ms",
-                  st.last_density_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
-  else
-    std::snprintf(buf, sizeof buf, "  dfsph %d+%d sweeps, err %.3f%%, dt %.3g ms", st.last_density_iterations,
-                  st.last_divergence_iterations, st.last_density_error, 1e3 * double(sim.last_dt()));
-  std::string line = buf;
-  if (st.max_iteration_hits > 0)
-    line += ", " + std::to_string(st.max_iteration_hits) + " solves at max_iterations";
-  return line;
-}
-
 // How many solves stopped at max_iterations get a warning line of their own; later ones are counted on the
 // progress line and in the summary, so that a run that keeps hitting the limit does not flood its log.
 constexpr std::uint64_t kMaxIterationWarnings = 10;
@@ -144,9 +124,9 @@ constexpr std::uint64_t kMaxIterationWarnings = 10;
 // such solves already reported on.
 template <int Dim, class Real>
 void warn_max_iterations(const Simulation<Dim, Real>& sim, Progress& progress, std::uint64_t& seen) {
-  const Model model = sim.config().model;
-  if (!implicit_pressure(model)) return;
-  const auto& st = sim.dfsph_stats();
+  const DfsphStats* stats = sim.solver_stats();
+  if (stats == nullptr) return;
+  const DfsphStats& st = *stats;
   const std::uint64_t before = seen;
   seen = st.max_iteration_hits;
   if (seen == before || before >= kMaxIterationWarnings) return;
@@ -154,15 +134,15 @@ void warn_max_iterations(const Simulation<Dim, Real>& sim, Progress& progress, s
   const std::string more = others == 0   ? ""
                            : others == 1 ? " (and one more solve of this step)"
                                          : " (and " + std::to_string(others) + " more solves of this step)";
-  const char* unit = model == Model::Iisph ? (st.last_hit_iterations == 1 ? "iteration" : "iterations")
-                                           : (st.last_hit_iterations == 1 ? "sweep" : "sweeps");
+  std::string unit = st.last_hit_unit;  // "sweeps" -> "1 sweep"
+  if (st.last_hit_iterations == 1) unit.pop_back();
   progress.finish();
   std::fprintf(
       stderr,
       "cellsph: warning: step %llu (t = %.6g s): the %s solve stopped at max_iterations (%d %s) with "
       "average error %.3g%%, above its bound %.3g%%%s%s\n",
       static_cast<unsigned long long>(st.last_hit_step), double(sim.time()), st.last_hit_solve,
-      st.last_hit_iterations, unit, st.last_hit_error, st.last_hit_bound, more.c_str(),
+      st.last_hit_iterations, unit.c_str(), st.last_hit_error, st.last_hit_bound, more.c_str(),
       seen >= kMaxIterationWarnings
           ? "; further ones are counted on the progress line and in the summary, not logged"
           : "");
@@ -481,7 +461,7 @@ std::string progress_line(const Simulation<Dim, Real>& sim, const RunStart& star
   return "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", end_time) + " s  frame " +
          std::to_string(next_frame) + "  " +
          fmt("%.0f", double(sim.steps() - start.steps) / std::max(w, 1e-9)) + " steps/s  " +
-         std::to_string(sim.fluid_count()) + " fluid particles" + dfsph_progress(sim);
+         std::to_string(sim.fluid_count()) + " fluid particles" + sim.solver_progress();
 }
 
 // Steps until --steps or the end time, or until a stop signal, sampling the probes and writing the frames
@@ -515,58 +495,11 @@ void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
   progress.finish();
 }
 
-// The summary's note on the last implicit solve stopped at max_iterations, if any.
-std::string last_hit_note(const DfsphStats& st) {
-  return st.max_iteration_hits ? " (last: step " + std::to_string(st.last_hit_step) + ", error " +
-                                     fmt("%.3g", st.last_hit_error) + "%)"
-                               : "";
-}
-
+// The summary: simulated time, wall time, steps and frames, where the time went, and the model's own lines
+// (the implicit solvers' figures, models/<model>_stepper.hpp).
 template <int Dim, class Real>
-void print_iisph_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Real>& cfg) {
-  const auto& tm = sim.timings();
-  const auto& st = sim.dfsph_stats();
-  const double n = double(std::max<std::uint64_t>(st.steps, 1));
-  const double its = double(st.density_iterations);
-  std::fprintf(stderr,
-               "         iisph: %.2f iterations/step, density error last %.3g%% max %.3g%% (bound %.3g%%), "
-               "%llu solves stopped at max_iterations%s\n",
-               its / n, st.last_density_error, st.max_density_error, double(cfg.dfsph.max_density_error),
-               static_cast<unsigned long long>(st.max_iteration_hits), last_hit_note(st).c_str());
-  std::fprintf(stderr,
-               "         iisph ms/step: search %.3g, density+alpha %.3g, non-pressure forces %.3g, pressure "
-               "solve %.3g, drift %.3g (%.3g ms an iteration)\n",
-               tm.neighbors / n, st.ms_factor / n, st.ms_nonpressure / n, st.ms_density / n, st.ms_drift / n,
-               its > 0 ? st.ms_density / its : 0.0);
-}
-
-template <int Dim, class Real>
-void print_dfsph_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Real>& cfg) {
-  const auto& tm = sim.timings();
-  const auto& st = sim.dfsph_stats();
-  const double n = double(std::max<std::uint64_t>(st.steps, 1));
-  std::fprintf(stderr,
-               "         dfsph: %.2f density + %.2f divergence sweeps/step, density error last %.3g%% "
-               "max %.3g%% (bound %.3g%%), %llu solves stopped at max_iterations%s\n",
-               double(st.density_iterations) / n, double(st.divergence_iterations) / n, st.last_density_error,
-               st.max_density_error, double(cfg.dfsph.max_density_error),
-               static_cast<unsigned long long>(st.max_iteration_hits), last_hit_note(st).c_str());
-  // Where a step's time goes (Simulation::dfsph_stats), for docs/benchmarks.md. The non-pressure forces
-  // are summed in the divergence solve's last pass (models/dfsph.hpp): their time is the solve's.
-  const double sweeps = double(st.density_iterations);
-  std::fprintf(stderr,
-               "         dfsph ms/step: search %.3g, density+alpha %.3g, divergence solve + non-pressure "
-               "forces %.3g, kick %.3g, density solve %.3g, drift %.3g (%.3g ms a density sweep)\n",
-               tm.neighbors / n, st.ms_factor / n, st.ms_divergence / n, st.ms_nonpressure / n,
-               st.ms_density / n, st.ms_drift / n, sweeps > 0 ? st.ms_density / sweeps : 0.0);
-}
-
-// The summary: simulated time, wall time, steps and frames, where the time went, and the implicit
-// solvers' figures.
-template <int Dim, class Real>
-void print_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Real>& cfg,
-                   const RunStart& start, const RunOutputs<Dim, Real>& outputs,
-                   const std::filesystem::path& out) {
+void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start,
+                   const RunOutputs<Dim, Real>& outputs, const std::filesystem::path& out) {
   const double w = start.wall.seconds();
   const auto& tm = sim.timings();
   const std::uint64_t steps = sim.steps() - start.steps;
@@ -581,8 +514,7 @@ void print_summary(const Simulation<Dim, Real>& sim, const SolverConfig<Dim, Rea
       steps ? (double(sim.time()) - start.time) / double(steps) : 0.0,
       static_cast<unsigned long long>(outputs.next_frame()), out.string().c_str(), pct(tm.neighbors).c_str(),
       pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
-  if (cfg.model == Model::Iisph) print_iisph_summary(sim, cfg);
-  if (cfg.model == Model::Dfsph) print_dfsph_summary(sim, cfg);
+  for (const std::string& line : sim.solver_summary()) std::fprintf(stderr, "         %s\n", line.c_str());
 }
 
 // Stopped between two steps: the state after the last step, with its frame counter, so the resume
@@ -632,7 +564,7 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   if (const int sig = g_stop_signal) return stop_with_checkpoint(sig, sim, outputs, given, out);
   outputs.write_end_checkpoint();
   if (opt.render && !opt.quiet) outputs.write_movie();
-  if (!opt.quiet) print_summary(sim, scene.solver, start, outputs, out);
+  if (!opt.quiet) print_summary(sim, start, outputs, out);
   return 0;
 }
 

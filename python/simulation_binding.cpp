@@ -242,8 +242,9 @@ class SimImpl final : public SimBase {
   // The implicit solves of DFSPH and IISPH (models/dfsph.hpp's DfsphStats), as `cellsph run`'s summary
   // shows them; None for the explicit models.
   [[nodiscard]] py::object solver_stats() const override {
-    if (!implicit_pressure(sim_.config().model)) return py::none();
-    const DfsphStats& st = sim_.dfsph_stats();
+    const DfsphStats* stats = sim_.solver_stats();
+    if (stats == nullptr) return py::none();
+    const DfsphStats& st = *stats;
     py::dict d;
     d["steps"] = st.steps;
     d["density_iterations"] = st.density_iterations;
