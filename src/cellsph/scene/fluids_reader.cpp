@@ -1,0 +1,206 @@
+// /fluids (docs/scenes.md, "fluids[k]"): the fluid at t = 0, boxes on the lattice and shaped volumes,
+// each checked against the fluid before it and the walls, and kept half a spacing from shaped walls.
+#include "cellsph/scene/scene_readers.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "cellsph/core/parallel.hpp"
+#include "cellsph/solver/initial.hpp"
+
+namespace cellsph::scene_detail {
+
+template <int Dim>
+double count_fluid_particles(const nlohmann::json& j, double spacing) {
+  double fluid = 0;
+  if (j.contains("fluids") && j["fluids"].is_array())
+    for (const auto& b : j["fluids"]) {
+      if (!b.is_object() || !b.contains("min") || !b.contains("max")) continue;
+      const auto &lo = b["min"], &hi = b["max"];
+      if (!lo.is_array() || !hi.is_array() || lo.size() != Dim || hi.size() != Dim) continue;
+      double n = 1;
+      for (std::size_t a = 0; a < Dim; ++a)
+        if (lo[a].is_number() && hi[a].is_number())
+          n *= std::max(0.0, std::round((hi[a].get<double>() - lo[a].get<double>()) / spacing));
+      fluid += n;
+    }
+  return fluid;
+}
+
+namespace {
+
+// Whether a fluid particle at x keeps half a spacing outside every shaped obstacle and inside some shaped
+// container (the box walls' rule: fluid half a spacing from the wall's face).
+template <int Dim>
+bool clear_of_walls(const geometry::P3& x, const Regions<Dim>& regions, double spacing) {
+  const double gap = 0.5 * spacing * (1 - 1e-9);
+  for (const auto& s : regions.solid_shapes) {
+    const auto side = s.classify(x, gap);
+    if (side.sign <= 0 || side.distance < gap) return false;
+  }
+  if (regions.container_shapes.empty()) return true;
+  for (const auto& s : regions.container_shapes) {
+    const auto side = s.classify(x, gap);
+    if (side.sign < 0 && !(side.distance < gap)) return true;
+  }
+  return false;
+}
+
+// Adds the fluid particles at `xs` that are clear of the shaped walls; returns how many.
+template <int Dim, class Real>
+std::size_t add_fluid(Particles<Dim, Real>& p, const std::vector<geometry::P3>& xs,
+                      const Regions<Dim>& regions, double spacing, std::int32_t phase,
+                      const Vec<Dim, Real>& vel) {
+  std::vector<std::uint8_t> keep(xs.size(), 1);
+  if (!regions.solid_shapes.empty() || !regions.container_shapes.empty())
+    parallel_for(xs.size(),
+                 [&](std::size_t i) { keep[i] = clear_of_walls(xs[i], regions, spacing) ? 1 : 0; });
+  std::size_t added = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    if (!keep[i]) continue;
+    Vec<Dim, Real> v;
+    for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(xs[i][static_cast<std::size_t>(a)]);
+    add_particle(p, v, phase, ParticleKind::Fluid, Real(0), vel);
+    ++added;
+  }
+  return added;
+}
+
+// What every fluid block adds to: the particles, the budget that counts them (its errors name the block in
+// /fluids, `list`), and the blocks read so far; and the walls it must keep clear of.
+template <int Dim, class Real>
+struct FluidTarget {
+  JsonReader& list;
+  double spacing;
+  const PhaseTable& phases;
+  const Regions<Dim>& regions;
+  ParticleBudget& budget;
+  Particles<Dim, Real>& p;
+  FluidBlocks<Dim>& out;
+};
+
+// Fails at `e` unless the bounds `b` keep clear of the fluid blocks and shaped fluid volumes before it and
+// of the obstacles, inside the boundary box; `why_blocks` says why two blocks must not overlap.
+template <int Dim, class Real>
+void check_fluid_bounds(const JsonReader& e, const Aabb<Dim>& b, const FluidTarget<Dim, Real>& t,
+                        const std::string& why_blocks) {
+  const double tol = 1e-9 * t.spacing;
+  for (std::size_t o = 0; o < t.out.blocks.size(); ++o)
+    if (overlap<Dim>(b, t.out.blocks[o], tol))
+      e.fail_here("overlaps fluid block " + std::to_string(o) + " " + why_blocks);
+  for (std::size_t o = 0; o < t.out.shape_bounds.size(); ++o)
+    if (overlap<Dim>(b, t.out.shape_bounds[o], tol))
+      e.fail_here("overlaps a shaped fluid volume before it (their bounds must not)");
+  for (std::size_t o = 0; o < t.regions.solids.size(); ++o)
+    if (overlap<Dim>(b, t.regions.solids[o], tol))
+      e.fail_here("overlaps obstacle " + std::to_string(o) + " of /boundary/obstacles");
+  if (t.regions.container && !inside<Dim>(b, *t.regions.container, tol))
+    e.fail_here("lies (partly) outside the boundary box");
+}
+
+// Fluid volume `k` of /fluids, `e`, of the given shape: the lattice sites inside it that are clear of the
+// shaped walls.
+template <int Dim, class Real>
+void add_fluid_volume(JsonReader& e, std::size_t k, const geometry::Shape& shape,
+                      const FluidTarget<Dim, Real>& t) {
+  const std::int32_t phase = t.phases.read_reference(e);
+  const auto vel = to_vec<Dim, Real>(e.vector("velocity", Dim, filled<Dim>(0)));
+  e.finish();
+  Aabb<Dim> b{filled<Dim>(0), filled<Dim>(0)};
+  for (std::size_t a = 0; a < Dim; ++a) {
+    b.lo[a] = shape.lo()[a];
+    b.hi[a] = shape.hi()[a];
+  }
+  check_fluid_bounds(e, b, t, "(the bounds of a shaped fluid volume must not)");
+  budget_shape<Dim>(t.budget, shape, t.spacing, 0, 1.1 * shape.volume() / std::pow(t.spacing, Dim) + 8,
+                    t.list, std::to_string(k), "this fluid volume");
+  const std::size_t first = t.p.size();
+  const std::vector<geometry::P3> xs = geometry::sample(shape, t.spacing, false, HUGE_VAL);
+  if (add_fluid(t.p, xs, t.regions, t.spacing, phase, vel) == 0)
+    e.fail_here("holds no particle: no lattice site of spacing " + std::to_string(t.spacing) +
+                " lies inside it, half a spacing inside the containers and outside the obstacles");
+  t.out.shape_bounds.push_back(b);
+  t.out.shape_ranges.emplace_back(first, t.p.size());
+  t.out.shape_phase.push_back(phase);
+}
+
+// The lattice of add_block in the block `b` of `n` cells, as points.
+template <int Dim, class Real>
+std::vector<geometry::P3> block_lattice(const Aabb<Dim>& b, const std::array<long, 3>& n, double spacing) {
+  std::vector<geometry::P3> xs;
+  xs.reserve(static_cast<std::size_t>(n[0] * n[1] * n[2]));
+  for (long kk = 0; kk < n[2]; ++kk)
+    for (long jj = 0; jj < n[1]; ++jj)
+      for (long ii = 0; ii < n[0]; ++ii) {
+        const long idx[3] = {ii, jj, kk};
+        geometry::P3 x{0, 0, 0};
+        for (std::size_t a = 0; a < Dim; ++a) {
+          const auto lo = static_cast<Real>(b.lo[a]);
+          x[a] = double(lo + (Real(idx[a]) + Real(0.5)) * static_cast<Real>(spacing));
+        }
+        xs.push_back(x);
+      }
+  return xs;
+}
+
+// A fluid block ("min", "max") of /fluids, `e`: the lattice of add_block, less (with shaped walls) what is
+// not clear of them.
+template <int Dim, class Real>
+void add_fluid_block(JsonReader& e, const FluidTarget<Dim, Real>& t) {
+  const auto b = read_box<Dim>(e);
+  const std::int32_t phase = t.phases.read_reference(e);
+  const auto vel = to_vec<Dim, Real>(e.vector("velocity", Dim, filled<Dim>(0)));
+  e.finish();
+  const auto n = cells_of<Dim>(b, t.spacing);
+  for (std::size_t a = 0; a < Dim; ++a)
+    if (n[a] < 1)
+      e.fail("max", "block holds no particle along axis " + std::to_string(a) + " (extent " +
+                        std::to_string(b.hi[a] - b.lo[a]) + " < spacing " + std::to_string(t.spacing) + ")");
+  check_fluid_bounds(e, b, t, "(particles would sit on top of each other)");
+  t.out.blocks.push_back(b);
+  t.out.phase.push_back(phase);
+  if (t.regions.solid_shapes.empty() && t.regions.container_shapes.empty()) {
+    const std::size_t first = t.p.size();
+    add_block(t.p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(t.spacing), phase);
+    for (std::size_t i = first; i < t.p.size(); ++i) t.p.v[i] = vel;
+    return;
+  }
+  if (add_fluid(t.p, block_lattice<Dim, Real>(b, n, t.spacing), t.regions, t.spacing, phase, vel) == 0)
+    e.fail_here("holds no particle half a spacing inside the containers and outside the obstacles");
+}
+
+}  // namespace
+
+template <int Dim, class Real>
+FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const MeshFiles& files, const PhaseTable& phases,
+                             const Regions<Dim>& regions, ParticleBudget& budget, Particles<Dim, Real>& p) {
+  if (!r.has("fluids")) r.fail("fluids", "missing (a list of fluid blocks is required)");
+  auto fr = r.child("fluids");
+  const std::size_t nf = fr.array_size();
+  if (nf == 0 && !r.has("emitters")) fr.fail_here("at least one fluid block (or an emitter) is needed");
+  FluidBlocks<Dim> out;
+  const FluidTarget<Dim, Real> target{fr, spacing, phases, regions, budget, p, out};
+  for (std::size_t k = 0; k < nf; ++k) {
+    auto e = fr.element(k);
+    if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
+    if (auto shape = read_shape<Dim>(e, spacing, files))
+      add_fluid_volume(e, k, *shape, target);
+    else
+      add_fluid_block(e, target);
+  }
+  return out;
+}
+
+template double count_fluid_particles<2>(const nlohmann::json&, double);
+template double count_fluid_particles<3>(const nlohmann::json&, double);
+
+#define CELLSPH_FLUIDS_INSTANTIATE(D, R)                                                              \
+  template FluidBlocks<D> read_fluids<D, R>(JsonReader&, double, const MeshFiles&, const PhaseTable&, \
+                                            const Regions<D>&, ParticleBudget&, Particles<D, R>&);
+CELLSPH_FLUIDS_INSTANTIATE(2, float)
+CELLSPH_FLUIDS_INSTANTIATE(2, double)
+CELLSPH_FLUIDS_INSTANTIATE(3, float)
+CELLSPH_FLUIDS_INSTANTIATE(3, double)
+#undef CELLSPH_FLUIDS_INSTANTIATE
+
+}  // namespace cellsph::scene_detail
