@@ -218,7 +218,7 @@ struct SolverConfig {
 
   // Particles outside this box (grown by one support length) stop the run as unstable. If not set, the
   // box above is used when enabled, otherwise the escape test is off. A scene without /domain or a box
-  // gets a default one (scene/scene.cpp, default_domain; domain_default says so in the diagnosis).
+  // gets a default one (scene/domain_reader.cpp, default_domain; domain_default says so in the diagnosis).
   bool domain_set = false;
   bool domain_default = false;
   V domain_lo{}, domain_hi{};
@@ -255,7 +255,7 @@ struct SolverConfig {
   SearchOptions search{};
   // Verlet lists: the search runs at h (1 + verlet_skin) and its lists are kept until a particle has moved
   // 0.45 of the skin. 0: a search every step. Results do not depend on it (pairs are re-filtered at h).
-  // Scenes with /solver/model = "dfsph" default to 0 (scene.cpp, read_solver).
+  // Scenes with /solver/model = "dfsph" default to 0 (scene/solver_reader.cpp, read_solver).
   Real verlet_skin = Real(0.15);
   // Every this many steps the fluid particles' arrays are permuted into cell order (Z-order of cells of
   // size h, ties by id), so that neighbours sit near each other in memory; 0: never (input order kept).
