@@ -35,7 +35,6 @@
 #include "cellsph/probes/probes.hpp"
 #include "cellsph/render/renderer.hpp"
 #include "cellsph/render/video.hpp"
-#include "cellsph/scene/builtin_scenes.hpp"
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"
@@ -707,17 +706,6 @@ void register_run(CLI::App& app, int& result) {
                   "removes the key), e.g. "
                   "--set /spacing=0.01 --set /boundary/model=akinci; repeatable; saved in run.json");
   sub->callback([opt, &result] { result = run_command(*opt); });
-
-  auto* scenes = app.add_subcommand("scenes", "List the built-in scenes");
-  scenes->callback([&result] {
-    for (const auto& s : builtin_scenes()) {
-      std::string src;
-      const auto j = read_scene_json(std::string(s.name), src);
-      const auto h = read_scene_header(j, src);
-      std::printf("%-22s %dD  %s\n", std::string(s.name).c_str(), h.dim, h.description.c_str());
-    }
-    result = 0;
-  });
 }
 
 }  // namespace cellsph::app

@@ -12,6 +12,7 @@ void register_neighbors(CLI::App& app, int& result);
 void register_bench(CLI::App& app, int& result);
 void register_run(CLI::App& app, int& result);
 void register_doctor(CLI::App& app, int& result);
+void register_scenes(CLI::App& app, int& result);
 // `cellsph bench steps` (cmd_bench_steps.cpp), added under `bench` by register_bench.
 void add_bench_steps(CLI::App& bench, int& result);
 

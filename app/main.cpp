@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   cellsph::app::register_neighbors(app, result);
   cellsph::app::register_bench(app, result);
   cellsph::app::register_run(app, result);
+  cellsph::app::register_scenes(app, result);
   cellsph::app::register_doctor(app, result);
   try {
     app.parse(argc, argv);

@@ -5,6 +5,6 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/lib/configure_release.sh
 # Only the program: the tests, benchmarks and Python module are scripts/test.sh's to build.
-cmake --build build/release -j "$(nproc)" --target cellsph >/dev/null
+cmake --build build/release -j "$(nproc)" --target cellsph_app >/dev/null
 if [ $# -eq 0 ]; then set -- run; fi
 exec build/release/cellsph "$@"
