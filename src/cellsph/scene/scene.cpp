@@ -66,7 +66,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   s.spacing = static_cast<Real>(spacing);
   auto& cfg = s.solver;
   const PhaseTable phases = read_phases(r, spacing, cfg);
-  check_dfsph_fits(j, source);
+  check_model_fits(j, source);
   read_solver(r, spacing, cfg);
   read_time(r, cfg, s.output);
   read_neighbors(r, cfg);

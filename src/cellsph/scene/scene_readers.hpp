@@ -118,9 +118,9 @@ struct FluidBlocks {
 template <int Dim, class Real>
 PhaseTable read_phases(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg);
 
-// /solver (solver_reader.cpp). check_dfsph_fits first refuses, in one message, the settings of other
-// sections that a scene switched to DFSPH or IISPH keeps and those models refuse.
-void check_dfsph_fits(const nlohmann::json& j, const std::string& source);
+// /solver (solver_reader.cpp). check_model_fits first refuses, in one message, the settings that a scene
+// switched to another model keeps and that model refuses, with the --set edits that fit.
+void check_model_fits(const nlohmann::json& j, const std::string& source);
 template <int Dim, class Real>
 void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg);
 

@@ -178,46 +178,101 @@ void read_solver(JsonReader& r, double spacing, SolverConfig<Dim, Real>& cfg) {
   sr.finish();
 }
 
-// A scene switched to DFSPH or IISPH (`--set /solver/model=dfsph` on a WCSPH scene) may keep settings of
-// the other models that they refuse: one message names them all, with the --set edits that make the scene
-// fit, rather than one refusal per run (docs/physics.md, "Model 3").
-void check_dfsph_fits(const nlohmann::json& j, const std::string& source) {
-  const auto at = [](const nlohmann::json& o, const char* key) -> const nlohmann::json* {
-    return o.is_object() && o.contains(key) ? &o[key] : nullptr;
-  };
-  const nlohmann::json* solver = at(j, "solver");
-  const nlohmann::json* model = solver ? at(*solver, "model") : nullptr;
-  if (!model || (*model != "dfsph" && *model != "iisph")) return;
-  const std::string name = *model == "dfsph" ? "DFSPH" : "IISPH";
+namespace {
+
+const nlohmann::json* json_at(const nlohmann::json* o, const char* key) {
+  return o && o->is_object() && o->contains(key) ? &(*o)[key] : nullptr;
+}
+
+// The settings of a scene that its model refuses, each with the edit that makes it fit.
+struct Misfits {
   std::string what, sets;
-  auto add = [&](const std::string& w, const std::string& set) {
+  void add(const std::string& w, const std::string& set) {
     what += what.empty() ? "" : "; ";
     what += w;
     sets += sets.empty() ? "" : " ";
     sets += set;
-  };
-  const nlohmann::json* boundary = at(j, "boundary");
-  if (const nlohmann::json* wm = boundary ? at(*boundary, "model") : nullptr;
-      wm && wm->is_string() && *wm != "akinci")
-    add("/boundary/model is " + json_value_text(*wm) + " (" + name +
-            " holds Akinci 2012 boundary particles only)",
-        "--set /boundary/model=akinci");
-  const nlohmann::json* av = at(*solver, "artificial_viscosity");
-  if (const nlohmann::json* alpha = av ? at(*av, "alpha") : nullptr;
+  }
+};
+
+// The paper model's own settings (interface tension by CSF or Akinci 2013, per-particle steps).
+void paper_only_misfits(const nlohmann::json& j, const std::string& name, Misfits& m) {
+  const nlohmann::json* solver = json_at(&j, "solver");
+  if (const nlohmann::json* t = json_at(solver, "tension"); t && t->is_string() && *t != "paper")
+    m.add("/solver/tension is " + json_value_text(*t) + " (" + name + " has no CSF or Akinci tension)",
+          "--set /solver/tension=paper");
+  const nlohmann::json* time = json_at(&j, "time");
+  if (const nlohmann::json* st = json_at(time, "stepping"); st && *st == "per-particle")
+    m.add("/time/stepping is \"per-particle\" (the paper model's leap-frog only)",
+          "--set /time/stepping=courant");
+}
+
+// WCSPH's own settings (artificial viscosity, the continuity density and its diffusion, floating bodies).
+void wcsph_only_misfits(const nlohmann::json& j, Misfits& m) {
+  if (const nlohmann::json* bodies = json_at(&j, "bodies"); bodies && !bodies->empty())
+    m.add("/bodies is set (floating bodies need the WCSPH model: their force is its wall term)",
+          "--set /bodies=null");
+  const nlohmann::json* solver = json_at(&j, "solver");
+  const nlohmann::json* av = json_at(solver, "artificial_viscosity");
+  if (const nlohmann::json* alpha = json_at(av, "alpha");
       alpha && alpha->is_number() && alpha->get<double>() > 0)
-    add("/solver/artificial_viscosity/alpha is " + json_value_text(*alpha) +
-            " (artificial viscosity is part of the WCSPH model)",
-        "--set /solver/artificial_viscosity/alpha=0");
-  if (const nlohmann::json* d = at(*solver, "density"); d && *d == "continuity")
-    add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model)",
-        "--set /solver/density=mass");
-  // A DFSPH scene switched to IISPH keeps its /solver/dfsph (IISPH's settings are /solver/iisph).
-  if (*model == "iisph" && at(*solver, "dfsph"))
-    add("/solver/dfsph is set (DFSPH's settings; IISPH takes its own, /solver/iisph)",
-        "--set /solver/dfsph=null");
-  if (what.empty()) return;
+    m.add("/solver/artificial_viscosity/alpha is " + json_value_text(*alpha) +
+              " (artificial viscosity is part of the WCSPH model)",
+          "--set /solver/artificial_viscosity/alpha=0");
+  if (const nlohmann::json* d = json_at(solver, "density"); d && *d == "continuity")
+    m.add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model)",
+          "--set /solver/density=mass");
+  const nlohmann::json* diffusion = json_at(solver, "density_diffusion");
+  if (const nlohmann::json* kind = json_at(diffusion, "kind"); kind && *kind != "none")
+    m.add("/solver/density_diffusion is set (it diffuses the continuity density)",
+          "--set /solver/density_diffusion=null");
+}
+
+// DFSPH's and IISPH's limits (Akinci walls, no surface tension) and each one's settings section.
+void implicit_misfits(const nlohmann::json& j, const std::string& name, Misfits& m) {
+  const nlohmann::json* boundary = json_at(&j, "boundary");
+  if (const nlohmann::json* wm = json_at(boundary, "model"); wm && wm->is_string() && *wm != "akinci")
+    m.add("/boundary/model is " + json_value_text(*wm) + " (" + name +
+              " holds Akinci 2012 boundary particles only)",
+          "--set /boundary/model=akinci");
+  if (const nlohmann::json* phases = json_at(&j, "phases"); phases && phases->is_array())
+    for (std::size_t k = 0; k < phases->size(); ++k)
+      if (const nlohmann::json* sigma = json_at(&(*phases)[k], "sigma");
+          sigma && sigma->is_number() && sigma->get<double>() > 0)
+        m.add("/phases/" + std::to_string(k) + "/sigma is " + json_value_text(*sigma) + " (" + name +
+                  " has no surface tension yet)",
+              "--set /phases/" + std::to_string(k) + "/sigma=0");
+}
+
+}  // namespace
+
+// A scene switched to another model (`--set /solver/model=dfsph` on a WCSPH scene) may keep settings that
+// the new model refuses: one message names them all, with the --set edits that make the scene fit,
+// rather than one refusal per run (docs/physics.md, "Model 3").
+void check_model_fits(const nlohmann::json& j, const std::string& source) {
+  const nlohmann::json* solver = json_at(&j, "solver");
+  const nlohmann::json* model = json_at(solver, "model");
+  if (!model || !model->is_string()) return;
+  const std::string m = *model;
+  if (m != "paper" && m != "wcsph" && m != "dfsph" && m != "iisph") return;  // read_solver names it
+  const std::string name = m == "paper"   ? "the paper model"
+                           : m == "wcsph" ? "WCSPH"
+                           : m == "dfsph" ? "DFSPH"
+                                          : "IISPH";
+  Misfits fits;
+  if (m == "dfsph" || m == "iisph") implicit_misfits(j, name, fits);
+  if (m != "wcsph") wcsph_only_misfits(j, fits);
+  if (m != "paper") paper_only_misfits(j, name, fits);
+  // The other implicit model's settings section (IISPH's are /solver/iisph, DFSPH's /solver/dfsph).
+  if (m != "dfsph" && json_at(solver, "dfsph"))
+    fits.add("/solver/dfsph is set (DFSPH's settings" +
+                 std::string(m == "iisph" ? "; IISPH takes its own, /solver/iisph)" : ")"),
+             "--set /solver/dfsph=null");
+  if (m != "iisph" && json_at(solver, "iisph"))
+    fits.add("/solver/iisph is set (IISPH's settings)", "--set /solver/iisph=null");
+  if (fits.what.empty()) return;
   throw InputError(source + ": /solver/model = " + json_value_text(*model) +
-                   " does not fit this scene's settings: " + what + ". Add: " + sets);
+                   " does not fit this scene's settings: " + fits.what + ". Add: " + fits.sets);
 }
 
 #define CELLSPH_SOLVER_INSTANTIATE(D, R) \
