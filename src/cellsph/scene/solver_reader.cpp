@@ -210,22 +210,23 @@ void paper_only_misfits(const nlohmann::json& j, const std::string& name, Misfit
 // WCSPH's own settings (artificial viscosity, the continuity density and its diffusion, floating bodies).
 void wcsph_only_misfits(const nlohmann::json& j, Misfits& m) {
   if (const nlohmann::json* bodies = json_at(&j, "bodies"); bodies && !bodies->empty())
-    m.add("/bodies is set (floating bodies need the WCSPH model: their force is its wall term)",
+    m.add("/bodies is set (floating bodies need the WCSPH model, \"wcsph\": their force is its wall term)",
           "--set /bodies=null");
   const nlohmann::json* solver = json_at(&j, "solver");
   const nlohmann::json* av = json_at(solver, "artificial_viscosity");
   if (const nlohmann::json* alpha = json_at(av, "alpha");
       alpha && alpha->is_number() && alpha->get<double>() > 0)
     m.add("/solver/artificial_viscosity/alpha is " + json_value_text(*alpha) +
-              " (artificial viscosity is part of the WCSPH model)",
+              " (artificial viscosity is part of the WCSPH model, \"wcsph\")",
           "--set /solver/artificial_viscosity/alpha=0");
   if (const nlohmann::json* d = json_at(solver, "density"); d && *d == "continuity")
-    m.add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model)",
+    m.add("/solver/density is \"continuity\" (the continuity density is part of the WCSPH model, \"wcsph\")",
           "--set /solver/density=mass");
   const nlohmann::json* diffusion = json_at(solver, "density_diffusion");
   if (const nlohmann::json* kind = json_at(diffusion, "kind"); kind && *kind != "none")
-    m.add("/solver/density_diffusion is set (it diffuses the continuity density)",
-          "--set /solver/density_diffusion=null");
+    m.add(
+        "/solver/density_diffusion is set (it diffuses the continuity density of the WCSPH model, \"wcsph\")",
+        "--set /solver/density_diffusion=null");
 }
 
 // DFSPH's and IISPH's limits (Akinci walls, no surface tension) and each one's settings section.
