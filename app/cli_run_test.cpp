@@ -326,5 +326,4 @@ TEST(CliRun, HelpDocumentsEveryOption) {
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt << " missing from --help:\n" << r.out;
 }
 
-
 }  // namespace

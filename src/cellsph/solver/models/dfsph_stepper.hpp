@@ -25,8 +25,9 @@ inline std::string format_number(const char* format, double v) {
 
 // ", N solves at max_iterations" of the progress line (nothing while there are none).
 inline std::string implicit_hits_progress(const DfsphStats& st) {
-  return st.max_iteration_hits > 0 ? ", " + std::to_string(st.max_iteration_hits) + " solves at max_iterations"
-                                   : std::string();
+  return st.max_iteration_hits > 0
+             ? ", " + std::to_string(st.max_iteration_hits) + " solves at max_iterations"
+             : std::string();
 }
 
 // The summary's errors: "density error last L% max M% (bound B%), N solves stopped at max_iterations[ (last:
@@ -36,8 +37,8 @@ inline std::string implicit_errors_summary(const DfsphStats& st, double bound) {
                   format_number("%.3g", st.max_density_error) + "% (bound " + format_number("%.3g", bound) +
                   "%), " + std::to_string(st.max_iteration_hits) + " solves stopped at max_iterations";
   if (st.max_iteration_hits)
-    s += " (last: step " + std::to_string(st.last_hit_step) + ", error " + format_number("%.3g", st.last_hit_error) +
-         "%)";
+    s += " (last: step " + std::to_string(st.last_hit_step) + ", error " +
+         format_number("%.3g", st.last_hit_error) + "%)";
   return s;
 }
 
@@ -97,8 +98,8 @@ class DfsphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
   [[nodiscard]] std::string progress(const DfsphStats& st, Real last_dt) const override {
     return "  dfsph " + std::to_string(st.last_density_iterations) + "+" +
            std::to_string(st.last_divergence_iterations) + " sweeps, err " +
-           format_number("%.3f", st.last_density_error) + "%, dt " + format_number("%.3g", 1e3 * double(last_dt)) +
-           " ms" + implicit_hits_progress(st);
+           format_number("%.3f", st.last_density_error) + "%, dt " +
+           format_number("%.3g", 1e3 * double(last_dt)) + " ms" + implicit_hits_progress(st);
   }
   // Sweeps a step, errors and solves stopped at max_iterations; where a step's time goes (the non-pressure
   // forces are summed in the divergence solve's last pass: their time is the solve's).
@@ -112,8 +113,9 @@ class DfsphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
                 format_number("%.3g", st.ms_factor / n) + ", divergence solve + non-pressure forces " +
                 format_number("%.3g", st.ms_divergence / n) + ", kick " +
                 format_number("%.3g", st.ms_nonpressure / n) + ", density solve " +
-                format_number("%.3g", st.ms_density / n) + ", drift " + format_number("%.3g", st.ms_drift / n) +
-                " (" + format_number("%.3g", sweeps > 0 ? st.ms_density / sweeps : 0.0) + " ms a density sweep)"};
+                format_number("%.3g", st.ms_density / n) + ", drift " +
+                format_number("%.3g", st.ms_drift / n) + " (" +
+                format_number("%.3g", sweeps > 0 ? st.ms_density / sweeps : 0.0) + " ms a density sweep)"};
   }
 
   Real advance(Ctx& c) override {

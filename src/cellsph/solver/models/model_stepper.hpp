@@ -60,7 +60,8 @@ class ModelStepper {
   // What `cellsph run` shows of the model, from the run's solver statistics `st` (this stepper's or, with a
   // device backend, the device's): its part of the progress line ("" for none) and its summary lines.
   [[nodiscard]] virtual std::string progress(const DfsphStats& /*st*/, Real /*last_dt*/) const { return {}; }
-  [[nodiscard]] virtual std::vector<std::string> summary(const DfsphStats& /*st*/, double /*search_ms*/) const {
+  [[nodiscard]] virtual std::vector<std::string> summary(const DfsphStats& /*st*/,
+                                                         double /*search_ms*/) const {
     return {};
   }
 };
