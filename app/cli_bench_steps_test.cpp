@@ -1,6 +1,5 @@
 // `cellsph bench steps`: runs, reports the three runs, and the two per-particle runs (work sets and every
 // density computed) do the same steps and force evaluations, as the solver test requires bit for bit.
-#ifdef CELLSPH_BINARY
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -67,4 +66,3 @@ TEST(BenchCli, StepsRejectsBadEdits) {
 
 }  // namespace
 }  // namespace cellsph::test
-#endif  // CELLSPH_BINARY

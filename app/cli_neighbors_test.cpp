@@ -1,10 +1,6 @@
 // The `cellsph neighbors` command-line contract (issue 2), tested on the built program:
 // outputs against a brute-force search written here, and every bad-input path (exit code 2, one
 // line naming file/row/column/value, no output file left behind).
-//
-// The top-level CMakeLists.txt globs app/*.cpp into the `cellsph` program too; CELLSPH_BINARY is
-// defined only for the test target, so the program sees an empty file here.
-#ifdef CELLSPH_BINARY
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -486,4 +482,3 @@ TEST(BenchCli, RejectsUnknownMethodAndBadSizes) {
 }
 
 }  // namespace
-#endif  // CELLSPH_BINARY

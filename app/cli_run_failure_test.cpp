@@ -111,7 +111,7 @@ class ScopedEnv {
 
 // Starts the built cellsph with `args`, stdout and stderr into `log`.
 pid_t spawn_cli(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> all{CELLSPH_BINARY};
+  std::vector<std::string> all{cellsph::test::binary()};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : all) argv.push_back(a.data());
@@ -121,7 +121,7 @@ pid_t spawn_cli(const std::vector<std::string>& args, const fs::path& log) {
   posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&fa, 1, 2);
   pid_t pid = -1;
-  const int rc = posix_spawn(&pid, CELLSPH_BINARY, &fa, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, cellsph::test::binary(), &fa, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   return rc == 0 ? pid : -1;
 }
@@ -232,7 +232,7 @@ TEST(CliRunFailedStart, NewRunLeavesTheOutputLocationAsItWas) {
 // truncated binary STL each stop the start with one line naming the scene file, the key and the mesh file.
 TEST(CliRunFailedStart, BadMeshFilesLeaveTheOutputLocationAsItWas) {
   TempDir dir;
-  const fs::path meshes = fs::path(CELLSPH_SOURCE_DIR) / "data" / "meshes";
+  const fs::path meshes = fs::path(cellsph::test::source_dir()) / "data" / "meshes";
   fs::create_directories(dir / "m");
   for (const char* f : {"open-cube.obj", "garbage.stl", "truncated.stl", "cube-binary.stl"})
     fs::copy_file(meshes / f, dir / "m" / f);
@@ -529,7 +529,7 @@ TEST(CliRunWriteFailure, RealFullDiskThenResumeWhenFreed) {
   auto r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "ref") + " --quiet --threads 2");
   ASSERT_EQ(r.code, 0) << r.err;
   fs::create_directories(dir / "mnt");
-  const std::string bin = q(CELLSPH_BINARY), m = q(dir / "mnt"), d = dir.path().string();
+  const std::string bin = q(cellsph::test::binary()), m = q(dir / "mnt"), d = dir.path().string();
   const std::string script = "mount -t tmpfs -o size=64k none " + m + " || exit 99; " + bin + " run " +
                              q(dir / "tiny.json") + " --out " + m + "/run --quiet --threads 2 2>'" + d +
                              "/err1'; echo $? >'" + d + "/code1'; cp -r " + m + "/run '" + d +
@@ -732,7 +732,7 @@ std::vector<double> numbers(const std::string& csv) {
 
 TEST(CliRunCheckpointFormat, AVersion1RunFolderStillResumes) {
   TempDir dir;
-  fs::copy(fs::path(CELLSPH_SOURCE_DIR) / "data" / "checkpoints" / "v1-tiny-2d", dir / "old",
+  fs::copy(fs::path(cellsph::test::source_dir()) / "data" / "checkpoints" / "v1-tiny-2d", dir / "old",
            fs::copy_options::recursive);
   auto r = run_cli(dir, "run --resume " + q(dir / "old") + " --until 0.1 --threads 2 --quiet");
   ASSERT_EQ(r.code, 0) << r.err;

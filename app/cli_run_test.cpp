@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
+#include "cellsph/render/image.hpp"
 #include "cli_test_util.hpp"
 
 namespace {
@@ -235,6 +237,42 @@ TEST(CliRun, SetEditsTheSceneAndIsSavedForResume) {
   EXPECT_FALSE(fs::exists(dir / "bad" / "frames.csv"));
 }
 
+// A scene without /solver/eos/stiffness gets c = 10 sqrt(2 g H) (scene/sound_speed_default.cpp): the
+// start says the value and how it was found, and run.json keeps it. The tiny scene's own stiffness
+// (Tait, k = 2e4 Pa: c = 11.8 m/s) compresses the bottom of its 0.6 m column by rho0 g H / (7 k) = 4.2%
+// once the column weighs on it, over the 3% bound, and the run says so once, then in the summary.
+TEST(CliRun, DerivedStiffnessIsSaidAndAWeakOneWarned) {
+  TempDir dir;
+  std::string s = kTiny;
+  const std::string given = "\"stiffness\": 20000, ";
+  s.erase(s.find(given), given.size());
+  write_file(dir / "derived.json", s);
+  auto r = run_cli(dir, "run " + q(dir / "derived.json") + " --out " + q(dir / "derived") + " --format csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("cellsph: /solver/eos/stiffness = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(not in the scene: speed of sound c = 10 sqrt(2 g H) = "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  const std::string run = read_file(dir / "derived" / "run.json");
+  EXPECT_NE(run.find("\"key\": \"/solver/eos/stiffness\""), std::string::npos) << run;
+
+  write_file(dir / "tiny.json", kTiny);
+  r = run_cli(dir, "run " + q(dir / "tiny.json") + " --out " + q(dir / "weak") + " --format csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string largest = "phase 0 (water): largest density ";
+  const std::size_t first = r.err.find("cellsph: warning: t = ");
+  ASSERT_NE(first, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(largest, first), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("raise /solver/eos/stiffness (now 2e+04, speed of sound 11.8 m/s)"), std::string::npos)
+      << r.err;
+  const std::size_t summary = r.err.find("cellsph: done: ");
+  ASSERT_NE(summary, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("         warning: t = ", summary), std::string::npos) << r.err;
+  // Once each: the largest density is named twice, in its warning and in the summary.
+  std::size_t count = 0;
+  for (std::size_t at = r.err.find(largest); at != std::string::npos; at = r.err.find(largest, at + 1)) ++count;
+  EXPECT_EQ(count, 2U) << r.err;
+}
+
 TEST(CliRun, UnstableRunStopsWithDiagnosisAndCode3) {
   TempDir dir;
   std::string s = kTiny;
@@ -296,6 +334,35 @@ TEST(CliRun, RenderWritesOnePngPerFrame) {
   ASSERT_EQ(r.code, 0) << r.err;
   for (int f = 0; f <= 2; ++f)
     EXPECT_TRUE(fs::exists(dir / "out" / "png" / ("frame_0000" + std::to_string(f) + ".png"))) << f;
+}
+
+// Pictures show what the water hits (issue 52 item 7): dam-break-3d's box obstacle changes the first
+// frame against the same scene without it, in grey, so neither the tank's near walls (cut away) nor
+// the fluid hides it. Before, walls and obstacles were not drawn and the two frames were alike.
+TEST(CliRun, RenderDrawsTheSolidsInGrey) {
+  TempDir dir;
+  auto frame = [&](const std::string& name, const std::string& extra) {
+    const auto r = run_cli(dir, "run dam-break-3d --out " + q(dir / name) +
+                                    " --quiet --format csv --render --steps 0" + extra);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return cellsph::read_png(dir / name / "png" / "frame_00000.png");
+  };
+  const cellsph::Image with = frame("with", ""), without = frame("without", " --set /boundary/obstacles=[]");
+  ASSERT_EQ(with.width, without.width);
+  ASSERT_EQ(with.height, without.height);
+  std::size_t changed = 0, grey = 0;
+  for (int y = 0; y < with.height; ++y)
+    for (int x = 0; x < with.width; ++x) {
+      const cellsph::Rgb8 a = with.at(x, y), b = without.at(x, y);
+      const auto diff = [](int u, int v) { return u > v ? u - v : v - u; };
+      if (diff(a[0], b[0]) + diff(a[1], b[1]) + diff(a[2], b[2]) < 24) continue;
+      ++changed;
+      const int hi = std::max({a[0], a[1], a[2]}), lo = std::min({a[0], a[1], a[2]});
+      if (hi - lo <= 24) ++grey;
+    }
+  // The obstacle, 0.3 x 0.6 m of a 4 x 3 m tank seen at 1280 x 720: thousands of pixels.
+  EXPECT_GT(changed, 2000U);
+  EXPECT_GT(grey, changed * 9 / 10) << grey << " of " << changed;
 }
 
 TEST(CliRun, SurfaceWritesOneMeshPerFrameAndPhase) {

@@ -30,7 +30,7 @@ std::string file_text(const fs::path& p) {
 // The JSON files of scenes/ (its folders hold meshes and examples that are not built in).
 std::vector<fs::path> scene_files() {
   std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(fs::path(CELLSPH_SOURCE_DIR) / "scenes"))
+  for (const auto& e : fs::directory_iterator(fs::path(cellsph::test::source_dir()) / "scenes"))
     if (e.path().extension() == ".json") files.push_back(e.path());
   return files;
 }
@@ -67,7 +67,7 @@ TEST(CliScenes, ListsEveryBuiltinSceneOnOneLineOfAtMost100Characters) {
 
 TEST(CliScenes, ShowsOneSceneInFull) {
   TempDir dir;
-  const fs::path file = fs::path(CELLSPH_SOURCE_DIR) / "scenes" / "droplet.json";
+  const fs::path file = fs::path(cellsph::test::source_dir()) / "scenes" / "droplet.json";
   const std::string text = file_text(file);
   const auto r = run_cli(dir, "scenes droplet");
   ASSERT_EQ(r.code, 0) << r.err;

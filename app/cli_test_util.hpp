@@ -1,6 +1,6 @@
 #pragma once
 // Helpers shared by the command-line tests: a scratch folder, file I/O, and running the built
-// `cellsph` (path in CELLSPH_BINARY) capturing exit code, stdout and stderr.
+// `cellsph` (test::binary(), core/test_paths.hpp) capturing exit code, stdout and stderr.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "cellsph/core/test_paths.hpp"
 
 namespace cellsph::test {
 
@@ -85,7 +87,7 @@ struct RunResult {
 inline RunResult run_cli(const TempDir& dir, const std::string& args) {
   const fs::path out = dir.path() / "..stdout", err = dir.path() / "..stderr";
   const std::string cmd =
-      std::string("'") + CELLSPH_BINARY + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+      std::string("'") + cellsph::test::binary() + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   RunResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

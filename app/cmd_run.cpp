@@ -37,6 +37,7 @@
 #include "cellsph/render/video.hpp"
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/compressibility_watch.hpp"
 #include "cellsph/solver/simulation.hpp"
 #include "cellsph/surface/surface.hpp"
 #include "commands.hpp"
@@ -145,6 +146,17 @@ void warn_max_iterations(const Simulation<Dim, Real>& sim, Progress& progress, s
       seen >= kMaxIterationWarnings
           ? "; further ones are counted on the progress line and in the summary, not logged"
           : "");
+}
+
+// The compressibility warnings (solver/compressibility_watch.hpp) that the particles call for, looked at
+// when a frame has been written: on a line of their own, each once.
+template <int Dim, class Real>
+void warn_compressibility(const Simulation<Dim, Real>& sim, Progress& progress,
+                         CompressibilityWatch<Dim, Real>& watch) {
+  for (const std::string& w : watch.check(sim.config(), sim.particles(), double(sim.time()))) {
+    progress.finish();
+    std::fprintf(stderr, "cellsph: warning: %s\n", w.c_str());
+  }
 }
 
 std::string fmt(const char* f, double v) {
@@ -300,12 +312,12 @@ class RunOutputs {
         floating_(!sim.body_states().empty()),
         body_log_(out / "bodies.csv",
                   {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"}) {
-    // Pictures show the floating bodies' particles too (the frames hold the fluid only; bodies.csv the
-    // bodies).
-    set_.ropt.visible = [&parts = sim.particles(), &body_of = sim.body_of_slot()](std::size_t i) {
-      return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid) ||
-             (i < body_of.size() && body_of[i] >= 0);
+    // Pictures show what the water hits: every wall, obstacle, gate and floating body in grey, a 3D
+    // tank's near walls cut away (the frames hold the fluid only; bodies.csv the bodies).
+    set_.ropt.solid = [&parts = sim.particles()](std::size_t i) {
+      return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Boundary);
     };
+    set_.ropt.solid_radius = 0.5 * double(scene.spacing);
     rbox_.lo = scene.view_lo;
     rbox_.hi = scene.view_hi;
   }
@@ -451,6 +463,8 @@ void print_run_header(const Scene<Dim, Real>& scene, const std::string& source,
                scene.header.name.c_str(), source.c_str(), sim.particles().size(), sim.fluid_count(), Dim,
                sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
                std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
+  for (const auto& d : scene.derived)
+    std::fprintf(stderr, "cellsph: %s = %.6g (not in the scene: %s)\n", d.key.c_str(), d.value, d.why.c_str());
 }
 
 template <int Dim, class Real>
@@ -467,7 +481,7 @@ std::string progress_line(const Simulation<Dim, Real>& sim, const RunStart& star
 // as they fall due, with a progress line after each step.
 template <int Dim, class Real>
 void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs, Progress& progress,
-                     const RunStart& start, const RunOptions& opt) {
+                     const RunStart& start, const RunOptions& opt, CompressibilityWatch<Dim, Real>& watch) {
   const double end_time = outputs.settings().end_time;
   auto done = [&] {
     if (opt.steps >= 0) return sim.steps() >= static_cast<std::uint64_t>(opt.steps);
@@ -481,7 +495,9 @@ void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
       sim.step();
       warn_max_iterations(sim, progress, max_iteration_hits_seen);
       outputs.sample_probes();
+      const std::uint64_t frames = outputs.next_frame();
       outputs.write_due_frames();
+      if (outputs.next_frame() != frames) warn_compressibility(sim, progress, watch);
       const double frac = opt.steps >= 0
                               ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
                               : (double(sim.time()) - start.time) / std::max(end_time - start.time, 1e-300);
@@ -497,8 +513,8 @@ void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
 // The summary: simulated time, wall time, steps and frames, where the time went, and the model's own lines
 // (the implicit solvers' figures, models/<model>_stepper.hpp).
 template <int Dim, class Real>
-void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start,
-                   const RunOutputs<Dim, Real>& outputs, const std::filesystem::path& out) {
+void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start, const RunOutputs<Dim, Real>& outputs,
+                   const CompressibilityWatch<Dim, Real>& watch, const std::filesystem::path& out) {
   const double w = start.wall.seconds();
   const auto& tm = sim.timings();
   const std::uint64_t steps = sim.steps() - start.steps;
@@ -514,6 +530,7 @@ void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start,
       static_cast<unsigned long long>(outputs.next_frame()), out.string().c_str(), pct(tm.neighbors).c_str(),
       pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
   for (const std::string& line : sim.solver_summary()) std::fprintf(stderr, "         %s\n", line.c_str());
+  for (const std::string& line : watch.given()) std::fprintf(stderr, "         warning: %s\n", line.c_str());
 }
 
 // Stopped between two steps: the state after the last step, with its frame counter, so the resume
@@ -538,7 +555,7 @@ int stop_with_checkpoint(int sig, const Simulation<Dim, Real>& sim, RunOutputs<D
 template <int Dim, class Real>
 int run_scene(const nlohmann::json& scene_json, const std::string& source, const RunOptions& opt,
               const RunOptions& given, const std::filesystem::path& out, bool resuming,
-              const std::function<void()>& start_output) {
+              const std::function<void(const std::vector<DerivedSetting>&)>& start_output) {
   Scene<Dim, Real> scene = load_scene<Dim, Real>(scene_json, source);
   apply_solver_options(scene.solver, opt, source);
   RunOutputSettings settings = output_settings(scene.output, opt);
@@ -552,18 +569,20 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
                  signal_name(g_stop_signal));
     return 128 + g_stop_signal;
   }
-  start_output();
+  start_output(scene.derived);
   outputs.make_folders();
 
   Progress progress(opt.quiet);
   const RunStart start{Stopwatch{}, sim.steps(), double(sim.time())};
   if (!opt.quiet) print_run_header(scene, source, sim, out);
-  step_until_done(sim, outputs, progress, start, opt);
+  for (const auto& w : scene.warnings) std::fprintf(stderr, "cellsph: warning: %s\n", w.c_str());
+  CompressibilityWatch<Dim, Real> watch;
+  step_until_done(sim, outputs, progress, start, opt, watch);
   outputs.flush_probes();
   if (const int sig = g_stop_signal) return stop_with_checkpoint(sig, sim, outputs, given, out);
   outputs.write_end_checkpoint();
   if (opt.render && !opt.quiet) outputs.write_movie();
-  if (!opt.quiet) print_summary(sim, start, outputs, out);
+  if (!opt.quiet) print_summary(sim, start, outputs, watch, out);
   return 0;
 }
 
@@ -618,7 +637,8 @@ void check_options(const RunOptions& opt) {
 // removed (a run killed mid-write, then resumed or started again into the same folder); a new run makes
 // the folder and run.json, the scene and options a resume reads back.
 void start_output(const std::filesystem::path& out, bool new_run, const nlohmann::json& scene_json,
-                  const std::string& source, const RunOptions& opt) {
+                  const std::string& source, const RunOptions& opt,
+                  const std::vector<DerivedSetting>& derived) {
   for (const auto& d : {out, out / "png", out / "surface"}) remove_stale_temporaries(d);
   if (!new_run) return;
   make_folder(out);
@@ -630,6 +650,9 @@ void start_output(const std::filesystem::path& out, bool new_run, const nlohmann
                       {"until", opt.until},     {"steps", opt.steps},
                       {"render", opt.render},   {"color_by", opt.color_by},
                       {"surface", opt.surface}, {"surface_format", opt.surface_format}};
+  // What the scene left out and load_scene derived from it (a resume derives it again, alike).
+  saved["derived"] = nlohmann::json::array();
+  for (const auto& d : derived) saved["derived"].push_back({{"key", d.key}, {"value", d.value}, {"why", d.why}});
   write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
 }
 
@@ -657,7 +680,9 @@ int run_command(RunOptions opt) {
 
   // Called by run_scene once everything is valid.
   const bool new_run = opt.resume.empty();
-  auto first_writes = [&] { start_output(out, new_run, scene_json, source, opt); };
+  auto first_writes = [&](const std::vector<DerivedSetting>& derived) {
+    start_output(out, new_run, scene_json, source, opt, derived);
+  };
 
   ScopedThreads threads(opt.threads);
   if (header.dim == 2)

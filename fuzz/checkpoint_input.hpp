@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/io/checkpoint.hpp"
 #include "cellsph/io/checkpoint_impl.hpp"
 #include "cellsph/io/simulation_checkpoint.hpp"
@@ -27,7 +28,7 @@ template <int Dim, class Real>
 const Scene<Dim, Real>& scene(const char* file) {
   static const Scene<Dim, Real> s = [file] {
     std::string source;
-    const auto j = read_scene_json(std::string(CELLSPH_SOURCE_DIR) + "/fuzz/scenes/" + file, source);
+    const auto j = read_scene_json(std::string(cellsph::test::source_dir()) + "/fuzz/scenes/" + file, source);
     return load_scene<Dim, Real>(j, source);
   }();
   return s;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/core/test_paths.hpp"
 #include "checkpoint_input.hpp"
 #include "frames_index_input.hpp"
 #include "mesh_input.hpp"
@@ -36,7 +37,7 @@ class FuzzReplay : public ::testing::TestWithParam<Harness> {};
 
 TEST_P(FuzzReplay, RegressionsAndSeedsAreReadOrRefused) {
   const Harness h = GetParam();
-  const std::filesystem::path root = std::filesystem::path(CELLSPH_SOURCE_DIR) / "fuzz";
+  const std::filesystem::path root = std::filesystem::path(cellsph::test::source_dir()) / "fuzz";
   std::size_t seeds = 0;
   for (const char* kind : {"corpus", "regressions"}) {
     const auto dir = root / kind / h.name;

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/error.hpp"
 #include "cellsph/geometry/mesh.hpp"
 #include "cellsph/geometry/shape.hpp"
@@ -19,7 +20,7 @@
 namespace cellsph::geometry {
 namespace {
 
-const std::filesystem::path kMeshes = std::filesystem::path(CELLSPH_SOURCE_DIR) / "data" / "meshes";
+const std::filesystem::path kMeshes = std::filesystem::path(cellsph::test::source_dir()) / "data" / "meshes";
 
 std::string error_of(const std::filesystem::path& file) {
   try {

@@ -84,6 +84,22 @@ struct EquationOfState {
     }
     return 0;
   }
+
+  // The stiffness whose sound_speed(rho0) is c: sound_speed's inverse, for the stiffness a scene derives
+  // from its height (scene/sound_speed_default.cpp).
+  CELLSPH_HD Real stiffness_for_sound_speed(Real c, Real rho0) const {
+    switch (kind) {
+      case EosKind::Tait:
+        return c * c * rho0 / gamma;
+      case EosKind::Linear:
+        return c * c;
+      case EosKind::Ratio:
+        return c * c * rho0;
+      case EosKind::Seventh:
+        return c * c * rho0 / Real(7);
+    }
+    return 0;
+  }
 };
 
 }  // namespace cellsph

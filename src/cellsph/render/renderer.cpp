@@ -478,7 +478,7 @@ ColourRange colour_range(const Particles<Dim, Real>& p, const RenderOptions& o) 
   double vmin = std::numeric_limits<double>::infinity(), vmax = -vmin;
   ColourRange r;
   for (std::size_t i = 0; i < n; ++i) {
-    if (o.visible && !o.visible(i)) continue;
+    if ((o.visible && !o.visible(i)) || (o.solid && o.solid(i))) continue;
     r.phases.insert(p.phase[i]);
     const double v = colour_value(p, o, i);
     if (std::isfinite(v)) {
@@ -495,11 +495,27 @@ ColourRange colour_range(const Particles<Dim, Real>& p, const RenderOptions& o) 
   return r;
 }
 
+template <int Dim, class Real>
+double particle_radius(const Particles<Dim, Real>& p, const RenderOptions& o, std::size_t i, double fallback) {
+  if (o.particle_radius > 0) return o.particle_radius;
+  const double m = static_cast<double>(p.m[i]), rho = static_cast<double>(p.rho[i]);
+  return m > 0 && rho > 0 ? 0.5 * std::pow(m / rho, 1.0 / Dim)
+                          : (p.h[i] > 0 ? static_cast<double>(p.h[i]) / 4 : fallback);
+}
+
+// Whether a solid at c lies outside the box on a side whose outside holds the eye: a near wall in 3D.
+bool cut_away(V3 c, const RenderBox& box, V3 eye) {
+  const double x[3] = {c.x, c.y, c.z}, e[3] = {eye.x, eye.y, eye.z};
+  for (std::size_t a = 0; a < 3; ++a)
+    if ((x[a] < box.lo[a] && e[a] < box.lo[a]) || (x[a] > box.hi[a] && e[a] > box.hi[a])) return true;
+  return false;
+}
+
 // One disc per visible particle: its radius the options' or half its volume's edge (else a quarter of h,
-// else a 400th of the box's diagonal), its colour its phase's or the colour map's.
+// else a 400th of the box's diagonal), its colour its phase's or the colour map's, a solid's grey.
 template <int Dim, class Real>
 std::vector<Sprite> make_sprites(const Particles<Dim, Real>& p, const RenderOptions& o, const RenderBox& box,
-                                 const ColourRange& range) {
+                                 const ColourRange& range, const View& view) {
   const auto n = p.size();
   const V3 diag = to_v3(box.hi) - to_v3(box.lo);
   const double fallback_radius = std::sqrt(dot(diag, diag)) / 400;
@@ -510,13 +526,14 @@ std::vector<Sprite> make_sprites(const Particles<Dim, Real>& p, const RenderOpti
     Sprite s;
     s.centre = {static_cast<double>(p.x[i][0]), static_cast<double>(p.x[i][1]),
                 Dim == 3 ? static_cast<double>(p.x[i][Dim - 1]) : 0.0};
-    double r = o.particle_radius;
-    if (!(r > 0)) {
-      const double m = static_cast<double>(p.m[i]), rho = static_cast<double>(p.rho[i]);
-      r = m > 0 && rho > 0 ? 0.5 * std::pow(m / rho, 1.0 / Dim)
-                           : (p.h[i] > 0 ? static_cast<double>(p.h[i]) / 4 : fallback_radius);
+    if (o.solid && o.solid(i)) {
+      if (Dim == 3 && cut_away(s.centre, box, view.eye)) continue;
+      s.colour = kSolidColour;
+      s.radius = o.solid_radius > 0 ? o.solid_radius : particle_radius(p, o, i, fallback_radius);
+      sprites.push_back(s);
+      continue;
     }
-    s.radius = r;
+    s.radius = particle_radius(p, o, i, fallback_radius);
     s.colour = o.color_by == ColorBy::Phase ? phase_colour(p.phase[i])
                                             : colormap((colour_value(p, o, i) - range.vmin) / range.span);
     sprites.push_back(s);
@@ -566,7 +583,7 @@ Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const 
                     p.h.size() == n && p.phase.size() == n,
                 "particle fields of unequal length");
   const ColourRange range = colour_range(p, o);
-  const std::vector<Sprite> sprites = make_sprites(p, o, box, range);
+  const std::vector<Sprite> sprites = make_sprites(p, o, box, range, vs.view);
 
   FrameBuffer fb(o.width * ss, o.height * ss, o.background);
   shade_sprites(fb, vs.view, sprites);

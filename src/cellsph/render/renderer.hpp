@@ -54,7 +54,16 @@ struct RenderOptions {
   Rgb8 background{250, 250, 250};
   // Which particles are drawn; empty = all (e.g. hide boundary particles). Called serially.
   std::function<bool(std::size_t)> visible;
+  // Which visible particles are solids (walls, obstacles, floating bodies): drawn in a neutral grey,
+  // shaded as the fluid, and left out of the colour range and the legend; empty = none. In 3D the
+  // solids outside the box on a side that faces the camera (a tank's near walls and lid) are cut away,
+  // so that the view into the box stays open; its floor and far walls stay. Called serially.
+  std::function<bool(std::size_t)> solid;
+  double solid_radius = 0;  // world units; 0 = as for the fluid
 };
+
+// The neutral colour of solids.
+inline constexpr Rgb8 kSolidColour{176, 174, 168};
 
 // Fixed palette: the colour of phase `phase` (cycled after 8; negative phases are grey).
 Rgb8 phase_colour(int phase);

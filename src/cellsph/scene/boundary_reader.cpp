@@ -22,6 +22,7 @@ void read_box_boundary(JsonReader& br, double spacing, SolverConfig<Dim, Real>& 
   cfg.box.radius = static_cast<Real>(bx.number("radius", spacing / 2, 0, 1e9));
   bx.finish();
   regions.container = b;
+  regions.container_key = bx.path();
 }
 
 template <int Dim, class Real>
@@ -77,6 +78,7 @@ void read_walls(JsonReader& br, double spacing, const SolverConfig<Dim, Real>& c
   add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
                 open_top, 0, weight, up);
   regions.container = b;
+  regions.container_key = wr.path();
 }
 
 // A shaped obstacle: `layers` layers of boundary particles on the lattice inside its surface, or, with
@@ -140,6 +142,7 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
           add_particle(p, x, 0, ParticleKind::Boundary);
         }
     regions.solids.push_back(b);
+    regions.solid_keys.push_back(e.path());
     mark_moving();
   }
 }

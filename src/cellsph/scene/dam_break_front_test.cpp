@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/probes/probes.hpp"
 #include "cellsph/scene/scene.hpp"
@@ -32,7 +33,7 @@ class DamBreakFront : public ::testing::TestWithParam<std::string> {};
 // particles cling leaves a trail above the surface. Returns table `index` (1: the front, 2: the residual
 // height) of section "[A]" or "[B]" as pairs of numbers.
 std::vector<std::pair<double, double>> martin_moyce(const std::string& table, int index = 2) {
-  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/data/validation/martin_moyce_1952.txt");
+  std::ifstream in(std::string(cellsph::test::source_dir()) + "/data/validation/martin_moyce_1952.txt");
   std::vector<std::pair<double, double>> out;
   std::string section;
   int tables = 0;  // tables seen in the section: the front, then the residual height
@@ -68,7 +69,7 @@ struct FrontPoint {
 std::vector<FrontPoint> published_fronts() {
   const double g = 9.81, a = 1.0;
   // The published data, copied into the repository (data/validation/, with its source in the header).
-  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/data/validation/koshizuka_oka_1996_front.tsv");
+  std::ifstream in(std::string(cellsph::test::source_dir()) + "/data/validation/koshizuka_oka_1996_front.tsv");
   std::vector<FrontPoint> ref;
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;

@@ -79,7 +79,9 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   Regions<Dim> regions = read_boundary(r, spacing, files, cfg, budget, s.particles);
   read_bodies(r, spacing, files, budget, s.particles, regions, cfg);
   read_domain(r, cfg, regions);
+  s.warnings = geometry_warnings(regions, spacing, double(cfg.support));
   const FluidBlocks<Dim> fluids = read_fluids(r, spacing, files, phases, regions, budget, s.particles);
+  if (auto d = default_stiffness(j, cfg, s.particles)) s.derived.push_back(std::move(*d));
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
   read_inflow(
       r, Dim, spacing, [&phases](JsonReader& e) { return phases.read_reference(e); }, cfg.inflow);

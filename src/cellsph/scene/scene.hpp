@@ -35,6 +35,15 @@ struct OutputSettings {
   int up_axis = 1;                          // world axis shown upwards in pictures
 };
 
+// A setting the scene left out that load_scene derived from the scene itself rather than take a fixed
+// default (docs/scenes.md, "Derived settings"): `cellsph run` prints it at the start and keeps it in
+// run.json.
+struct DerivedSetting {
+  std::string key;  // JSON pointer of the setting, e.g. /solver/eos/stiffness
+  double value = 0;
+  std::string why;  // how it was derived, with the numbers
+};
+
 template <int Dim, class Real>
 struct Scene {
   SceneHeader header;
@@ -46,6 +55,8 @@ struct Scene {
   std::array<double, 3> view_lo{}, view_hi{};  // the box drawn in pictures
   std::vector<Probe> probes;                   // sampled into probes.csv (probes/probes.hpp)
   double probes_every = 0.01;                  // [s] between probe samples
+  std::vector<DerivedSetting> derived;         // the settings derived from the scene
+  std::vector<std::string> warnings;           // what the scene's geometry resolves poorly, one sentence each
 };
 
 // A scene's JSON text: `name_or_path` is a built-in scene name or a path to a .json file. `source`

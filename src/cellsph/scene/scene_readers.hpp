@@ -94,7 +94,9 @@ struct PhaseTable {
 template <int Dim>
 struct Regions {
   std::vector<Aabb<Dim>> solids;       // regions fluid must not overlap
+  std::vector<std::string> solid_keys;  // their key paths, for messages
   std::optional<Aabb<Dim>> container;  // region fluid must lie in
+  std::string container_key;           // the walls' key path when walls make it (box or walls)
   // Shaped obstacles and containers (boundary.obstacles with "mesh", "sphere" or "cylinder"): fluid
   // particles keep half a spacing outside every obstacle and inside some container.
   std::vector<geometry::Shape> solid_shapes, container_shapes;
@@ -174,6 +176,18 @@ FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const MeshFiles& fil
 template <int Dim, class Real>
 void read_initial_pressure(JsonReader& r, double spacing, const SolverConfig<Dim, Real>& cfg,
                            const PhaseTable& phases, const FluidBlocks<Dim>& fluids, Particles<Dim, Real>& p);
+
+// /solver/eos/stiffness derived from the scene where it leaves it out and its model has a state equation
+// (sound_speed_default.cpp): sets cfg.eos.stiffness and says how.
+template <int Dim, class Real>
+std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverConfig<Dim, Real>& cfg,
+                                                const Particles<Dim, Real>& p);
+
+// Geometry the spacing resolves poorly (geometry_warnings.cpp): a gap narrower than two spacings between two
+// box obstacles or an obstacle and the tank's walls, an obstacle thinner than the kernel support. One
+// sentence each, naming the keys; nothing is changed.
+template <int Dim>
+std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double spacing, double support);
 
 // /output, and the box drawn in pictures (output_reader.cpp).
 template <int Dim>

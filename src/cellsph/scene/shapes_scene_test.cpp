@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/probes/probes.hpp"
 #include "cellsph/scene/scene.hpp"
@@ -17,7 +18,7 @@ namespace cellsph {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kMeshes = fs::path(CELLSPH_SOURCE_DIR) / "data" / "meshes";
+const fs::path kMeshes = fs::path(cellsph::test::source_dir()) / "data" / "meshes";
 
 struct TempDir {
   fs::path path;

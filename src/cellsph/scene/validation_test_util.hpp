@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/probes/probes.hpp"
 #include "cellsph/scene/scene.hpp"
@@ -21,7 +22,7 @@ namespace cellsph::validation {
 // A tab-separated table of data/validation/FILE: '#' lines are comments, the first other line is the
 // header. Empty when the file is missing or malformed (the caller asserts on it).
 inline std::map<std::string, std::vector<double>> read_table(const std::string& file) {
-  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/data/validation/" + file);
+  std::ifstream in(std::string(cellsph::test::source_dir()) + "/data/validation/" + file);
   std::map<std::string, std::vector<double>> cols;
   std::vector<std::string> head;
   for (std::string line; std::getline(in, line);) {

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/io/io_test_util.hpp"
@@ -468,7 +469,7 @@ TEST(RigidBodies, HostDeviceStepsAreBitIdenticalToTheCpu) {
 // rigid (every body particle keeps its distance to the body's centre), the flow carries it downstream,
 // and 1 and 2 threads, the host-emulated device and a run resumed from a checkpoint give the same bits.
 TEST(RigidBodies, BodiesRideWithEmittersAndSinks) {
-  std::ifstream in(std::string(CELLSPH_SOURCE_DIR) + "/scenes/channel-inflow.json");
+  std::ifstream in(std::string(cellsph::test::source_dir()) + "/scenes/channel-inflow.json");
   json j = json::parse(in);
   j["bodies"] = json::array({box_body(0.1, 0.03, 0.14, 0.07, 1000)});
   auto s = load(j);

@@ -1,0 +1,62 @@
+// Under-resolved geometry is said when a scene loads (issue 52 item 5): gaps under two spacings between
+// box obstacles or an obstacle and the tank's walls, obstacles thinner than the kernel support. The
+// gaps and thicknesses are set here by hand.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "cellsph/scene/scene.hpp"
+
+namespace cellsph {
+namespace {
+
+// A 1 x 1 m tank at spacing 0.02 and support 0.04, with the obstacles given.
+std::vector<std::string> warnings_of(const nlohmann::json& obstacles) {
+  auto j = nlohmann::json::parse(R"({
+    "dimension": 2, "spacing": 0.02,
+    "phases": [{"name": "water", "rest_density": 1000}],
+    "solver": {"model": "wcsph", "support": 0.04, "eos": {"stiffness": 1e5}},
+    "fluids": [{"min": [0, 0.6], "max": [1, 0.8]}],
+    "boundary": {"model": "adami", "walls": {"min": [0, 0], "max": [1, 1], "layers": 2}}
+  })");
+  j["boundary"]["obstacles"] = obstacles;
+  return load_scene<2, double>(j, "gaps.json").warnings;
+}
+
+nlohmann::json box(double x0, double y0, double x1, double y1) {
+  return {{"min", {x0, y0}}, {"max", {x1, y1}}};
+}
+
+TEST(GeometryWarnings, WellResolvedGeometryIsQuiet) {
+  // Gaps of 2.5 spacings between the two blocks and to the right wall; both 0.1 m thick.
+  EXPECT_TRUE(warnings_of(nlohmann::json::array({box(0.2, 0, 0.3, 0.3), box(0.35, 0, 0.45, 0.3)})).empty());
+  EXPECT_TRUE(warnings_of(nlohmann::json::array({box(0.85, 0, 0.95, 0.3)})).empty());
+}
+
+TEST(GeometryWarnings, ANarrowGapBetweenObstaclesNamesBoth) {
+  const auto w = warnings_of(nlohmann::json::array({box(0.2, 0, 0.3, 0.3), box(0.33, 0, 0.43, 0.3)}));
+  ASSERT_EQ(w.size(), 1U);
+  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0 and /boundary/obstacles/1: a gap of 0.03 m along x (1.5 spacings)",
+                       0),
+            0U)
+      << w[0];
+  EXPECT_NE(w[0].find("at most 0.015 m"), std::string::npos) << w[0];
+}
+
+TEST(GeometryWarnings, ANarrowGapToTheWallsNamesTheWalls) {
+  const auto w = warnings_of(nlohmann::json::array({box(0.8, 0, 0.97, 0.3)}));
+  ASSERT_EQ(w.size(), 1U);
+  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0 and /boundary/walls: a gap of 0.03 m along x", 0), 0U) << w[0];
+}
+
+TEST(GeometryWarnings, AnObstacleThinnerThanTheSupport) {
+  // 0.03 m thick along x (1.5 spacings, under the 0.04 m support); 0.3 m along y.
+  const auto w = warnings_of(nlohmann::json::array({box(0.5, 0, 0.53, 0.3)}));
+  ASSERT_EQ(w.size(), 1U);
+  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0: 0.03 m thick along x, thinner than the kernel support 0.04 m", 0),
+            0U)
+      << w[0];
+}
+
+}  // namespace
+}  // namespace cellsph
