@@ -96,6 +96,17 @@ std::size_t count_lines(const std::string& s) {
   return n;
 }
 
+// The lines that are not warnings (the tiny scene's weak speed of sound is warned before a fault stops it).
+std::size_t count_lines_but_warnings(const std::string& s) {
+  std::size_t n = 0;
+  for (std::size_t at = 0; at < s.size();) {
+    const std::size_t end = std::min(s.find('\n', at), s.size());
+    n += s.compare(at, 18, "cellsph: warning: ") != 0;
+    at = end + 1;
+  }
+  return n;
+}
+
 class ScopedEnv {
  public:
   ScopedEnv(const char* name, const std::string& value) : name_(name) { ::setenv(name, value.c_str(), 1); }
@@ -409,7 +420,7 @@ TEST(CliRunWriteFailure, StopsWithCode4KeepsFramesAndResumesBitForBit) {
       r = run_cli(dir, start);
     }
     EXPECT_EQ(r.code, 4) << r.err;
-    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_EQ(count_lines_but_warnings(r.err), 1u) << r.err;
     EXPECT_NE(r.err.find("cannot write '" + out.string() + "/"), std::string::npos) << r.err;
     EXPECT_NE(
         r.err.find(stage == "fsync" || stage == "close" ? "Input/output error" : "No space left on device"),

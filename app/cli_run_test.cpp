@@ -250,7 +250,8 @@ TEST(CliRun, DerivedStiffnessIsSaidAndAWeakOneWarned) {
   auto r = run_cli(dir, "run " + q(dir / "derived.json") + " --out " + q(dir / "derived") + " --format csv");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("cellsph: /solver/eos/stiffness = "), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("(not in the scene: speed of sound c = 10 sqrt(2 g H) = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(not in the scene: speed of sound c = 10 sqrt(2 g H) = "), std::string::npos)
+      << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   const std::string run = read_file(dir / "derived" / "run.json");
   EXPECT_NE(run.find("\"key\": \"/solver/eos/stiffness\""), std::string::npos) << run;
@@ -269,7 +270,8 @@ TEST(CliRun, DerivedStiffnessIsSaidAndAWeakOneWarned) {
   EXPECT_NE(r.err.find("         warning: t = ", summary), std::string::npos) << r.err;
   // Once each: the largest density is named twice, in its warning and in the summary.
   std::size_t count = 0;
-  for (std::size_t at = r.err.find(largest); at != std::string::npos; at = r.err.find(largest, at + 1)) ++count;
+  for (std::size_t at = r.err.find(largest); at != std::string::npos; at = r.err.find(largest, at + 1))
+    ++count;
   EXPECT_EQ(count, 2U) << r.err;
 }
 
@@ -342,8 +344,8 @@ TEST(CliRun, RenderWritesOnePngPerFrame) {
 TEST(CliRun, RenderDrawsTheSolidsInGrey) {
   TempDir dir;
   auto frame = [&](const std::string& name, const std::string& extra) {
-    const auto r = run_cli(dir, "run dam-break-3d --out " + q(dir / name) +
-                                    " --quiet --format csv --render --steps 0" + extra);
+    const auto r = run_cli(
+        dir, "run dam-break-3d --out " + q(dir / name) + " --quiet --format csv --render --steps 0" + extra);
     EXPECT_EQ(r.code, 0) << r.err;
     return cellsph::read_png(dir / name / "png" / "frame_00000.png");
   };

@@ -86,8 +86,8 @@ struct RunResult {
 // Runs the built cellsph with `args` (already shell-quoted where needed).
 inline RunResult run_cli(const TempDir& dir, const std::string& args) {
   const fs::path out = dir.path() / "..stdout", err = dir.path() / "..stderr";
-  const std::string cmd =
-      std::string("'") + cellsph::test::binary() + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const std::string cmd = std::string("'") + cellsph::test::binary() + "' " + args + " >'" + out.string() +
+                          "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   RunResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -152,12 +152,15 @@ void warn_max_iterations(const Simulation<Dim, Real>& sim, Progress& progress, s
 // when a frame has been written: on a line of their own, each once.
 template <int Dim, class Real>
 void warn_compressibility(const Simulation<Dim, Real>& sim, Progress& progress,
-                         CompressibilityWatch<Dim, Real>& watch) {
+                          CompressibilityWatch<Dim, Real>& watch) {
   for (const std::string& w : watch.check(sim.config(), sim.particles(), double(sim.time()))) {
     progress.finish();
     std::fprintf(stderr, "cellsph: warning: %s\n", w.c_str());
   }
 }
+
+// The share of the fluid per simulated second that the solid guard may put back before the summary warns.
+constexpr double kWallCorrectionWarning = 0.001;
 
 std::string fmt(const char* f, double v) {
   char buf[64];
@@ -464,7 +467,8 @@ void print_run_header(const Scene<Dim, Real>& scene, const std::string& source,
                sizeof(Real) == 4 ? "float" : "double", std::string(model_name(cfg.model)).c_str(),
                std::string(method_name(cfg.search.method)).c_str(), max_threads(), out.string().c_str());
   for (const auto& d : scene.derived)
-    std::fprintf(stderr, "cellsph: %s = %.6g (not in the scene: %s)\n", d.key.c_str(), d.value, d.why.c_str());
+    std::fprintf(stderr, "cellsph: %s = %.6g (not in the scene: %s)\n", d.key.c_str(), d.value,
+                 d.why.c_str());
 }
 
 template <int Dim, class Real>
@@ -474,7 +478,29 @@ std::string progress_line(const Simulation<Dim, Real>& sim, const RunStart& star
   return "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", end_time) + " s  frame " +
          std::to_string(next_frame) + "  " +
          fmt("%.0f", double(sim.steps() - start.steps) / std::max(w, 1e-9)) + " steps/s  " +
-         std::to_string(sim.fluid_count()) + " fluid particles" + sim.solver_progress();
+         std::to_string(sim.fluid_count()) + " fluid particles" + sim.solver_progress() +
+         (sim.wall_corrections() > 0 ? "  put back from walls " + std::to_string(sim.wall_corrections())
+                                     : "");
+}
+
+// The solid guard's count (boundary/solid_guard.hpp) for the summary, with a warning when it put back more
+// than kWallCorrectionWarning of the fluid per simulated second: the walls' pressure is too weak to stop
+// what the flow throws at them.
+template <int Dim, class Real>
+void print_wall_corrections(const Simulation<Dim, Real>& sim, double simulated) {
+  const std::uint64_t n = sim.wall_corrections();
+  if (n == 0) return;
+  const double rate =
+      double(n) / std::max<double>(1, double(sim.fluid_count())) / std::max(simulated, 1e-300);
+  std::fprintf(stderr,
+               "         walls: %llu fluid particles put back out of a wall or obstacle (%.3g%% of the fluid "
+               "per simulated second)\n",
+               static_cast<unsigned long long>(n), 100 * rate);
+  if (rate > kWallCorrectionWarning)
+    std::fprintf(stderr,
+                 "         warning: over %.3g%% of the fluid per second: the walls or the speed of sound are "
+                 "too weak for this flow; raise /solver/eos/stiffness, or try /boundary/model \"adami\"\n",
+                 100 * kWallCorrectionWarning);
 }
 
 // Steps until --steps or the end time, or until a stop signal, sampling the probes and writing the frames
@@ -513,8 +539,9 @@ void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
 // The summary: simulated time, wall time, steps and frames, where the time went, and the model's own lines
 // (the implicit solvers' figures, models/<model>_stepper.hpp).
 template <int Dim, class Real>
-void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start, const RunOutputs<Dim, Real>& outputs,
-                   const CompressibilityWatch<Dim, Real>& watch, const std::filesystem::path& out) {
+void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start,
+                   const RunOutputs<Dim, Real>& outputs, const CompressibilityWatch<Dim, Real>& watch,
+                   const std::filesystem::path& out) {
   const double w = start.wall.seconds();
   const auto& tm = sim.timings();
   const std::uint64_t steps = sim.steps() - start.steps;
@@ -531,6 +558,7 @@ void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start, cons
       pct(tm.forces).c_str(), pct(tm.integration).c_str(), pct(output_ms).c_str());
   for (const std::string& line : sim.solver_summary()) std::fprintf(stderr, "         %s\n", line.c_str());
   for (const std::string& line : watch.given()) std::fprintf(stderr, "         warning: %s\n", line.c_str());
+  print_wall_corrections(sim, double(sim.time()) - start.time);
 }
 
 // Stopped between two steps: the state after the last step, with its frame counter, so the resume
@@ -652,7 +680,8 @@ void start_output(const std::filesystem::path& out, bool new_run, const nlohmann
                       {"surface", opt.surface}, {"surface_format", opt.surface_format}};
   // What the scene left out and load_scene derived from it (a resume derives it again, alike).
   saved["derived"] = nlohmann::json::array();
-  for (const auto& d : derived) saved["derived"].push_back({{"key", d.key}, {"value", d.value}, {"why", d.why}});
+  for (const auto& d : derived)
+    saved["derived"].push_back({{"key", d.key}, {"value", d.value}, {"why", d.why}});
   write_file_atomic(out / kRunFile, saved.dump(2) + "\n");
 }
 

@@ -138,6 +138,7 @@ class SimBase {
   virtual void step() = 0;
   [[nodiscard]] virtual double time() const = 0;
   [[nodiscard]] virtual std::uint64_t steps() const = 0;
+  [[nodiscard]] virtual std::uint64_t wall_corrections() const = 0;
   [[nodiscard]] virtual double last_dt() const = 0;
   [[nodiscard]] virtual std::size_t size() const = 0;
   [[nodiscard]] virtual std::size_t fluid_count() const = 0;
@@ -180,6 +181,7 @@ class SimImpl final : public SimBase {
   void use_backend(Backend b) override { sim_.use_backend(b); }
   [[nodiscard]] double time() const override { return double(sim_.time()); }
   [[nodiscard]] std::uint64_t steps() const override { return sim_.steps(); }
+  [[nodiscard]] std::uint64_t wall_corrections() const override { return sim_.wall_corrections(); }
   [[nodiscard]] double last_dt() const override { return double(sim_.last_dt()); }
   [[nodiscard]] std::size_t size() const override { return sim_.particles().size(); }
   [[nodiscard]] std::size_t fluid_count() const override { return sim_.fluid_count(); }
@@ -535,6 +537,11 @@ void def_simulation_state(py::class_<PySimulation>& c) {
       .def_property_readonly(
           "steps", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.steps(); }); },
           "Steps taken.")
+      .def_property_readonly(
+          "wall_corrections",
+          [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.wall_corrections(); }); },
+          "Fluid particles put back out of a wall or obstacle they would have ended a step inside, since "
+          "this Simulation was made (docs/physics.md, \"Walls that hold every particle\").")
       .def_property_readonly(
           "dt", [](const PySimulation& s) { return s.locked([](SimBase& b) { return b.last_dt(); }); },
           "The last step's dt [s].")

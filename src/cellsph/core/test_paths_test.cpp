@@ -4,10 +4,14 @@
 
 namespace cellsph::test {
 
-const char* source_dir() { return CELLSPH_SOURCE_DIR; }
+const char* source_dir() {
+  return CELLSPH_SOURCE_DIR;
+}
 
 #ifdef CELLSPH_BINARY
-const char* binary() { return CELLSPH_BINARY; }
+const char* binary() {
+  return CELLSPH_BINARY;
+}
 #endif
 
 }  // namespace cellsph::test

@@ -12,8 +12,8 @@
 #include <sstream>
 #include <string>
 
-#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/geometry/mesh.hpp"
 #include "cellsph/geometry/shape.hpp"
 

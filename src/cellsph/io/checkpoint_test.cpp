@@ -84,7 +84,8 @@ TEST(Checkpoint, SolverStateRoundTrips) {
 // build before the solver state existed: 33 particles of a 2D double run at t = 0.03 s, step 3) is still
 // read, with a solver state of 0 (what that build resumed with).
 TEST(Checkpoint, Version1FileIsReadWithAZeroSolverState) {
-  const std::filesystem::path file = std::string(cellsph::test::source_dir()) + "/fuzz/corpus/checkpoint/checkpoint-2d.bin";
+  const std::filesystem::path file =
+      std::string(cellsph::test::source_dir()) + "/fuzz/corpus/checkpoint/checkpoint-2d.bin";
   const auto h = read_checkpoint_header(file);
   EXPECT_EQ(h.version, 1u);
   Particles<2, double> q;

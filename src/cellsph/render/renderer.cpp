@@ -496,7 +496,8 @@ ColourRange colour_range(const Particles<Dim, Real>& p, const RenderOptions& o) 
 }
 
 template <int Dim, class Real>
-double particle_radius(const Particles<Dim, Real>& p, const RenderOptions& o, std::size_t i, double fallback) {
+double particle_radius(const Particles<Dim, Real>& p, const RenderOptions& o, std::size_t i,
+                       double fallback) {
   if (o.particle_radius > 0) return o.particle_radius;
   const double m = static_cast<double>(p.m[i]), rho = static_cast<double>(p.rho[i]);
   return m > 0 && rho > 0 ? 0.5 * std::pow(m / rho, 1.0 / Dim)

@@ -50,7 +50,7 @@ void read_planes(JsonReader& br, SolverConfig<Dim, Real>& cfg) {
 }
 
 template <int Dim, class Real>
-void read_walls(JsonReader& br, double spacing, const SolverConfig<Dim, Real>& cfg, ParticleBudget& budget,
+void read_walls(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, ParticleBudget& budget,
                 Particles<Dim, Real>& p, Regions<Dim>& regions) {
   if (!br.has("walls")) return;
   auto wr = br.child("walls");
@@ -77,6 +77,10 @@ void read_walls(JsonReader& br, double spacing, const SolverConfig<Dim, Real>& c
     if (std::abs(cfg.gravity[a]) > std::abs(cfg.gravity[up])) up = a;
   add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
                 open_top, 0, weight, up);
+  cfg.guard.container = true;
+  cfg.guard.lo = to_vec<Dim, Real>(b.lo);
+  cfg.guard.hi = to_vec<Dim, Real>(b.hi);
+  cfg.guard.open_axis = open_top ? up : -1;
   regions.container = b;
   regions.container_key = wr.path();
 }
@@ -143,6 +147,7 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
         }
     regions.solids.push_back(b);
     regions.solid_keys.push_back(e.path());
+    if (motion < 0) cfg.guard.boxes.push_back({to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi)});
     mark_moving();
   }
 }
@@ -157,6 +162,8 @@ Regions<Dim> read_boundary(JsonReader& r, double spacing, const MeshFiles& files
   auto br = r.child("boundary");
   cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
   cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic"}));
+  cfg.guard.depth = static_cast<Real>(kGuardDepth * spacing);
+  cfg.guard.margin = static_cast<Real>(kGuardMargin * spacing);
   read_box_boundary(br, spacing, cfg, regions);
   read_planes(br, cfg);
   read_walls(br, spacing, cfg, budget, p, regions);

@@ -63,7 +63,8 @@ std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double s
         out.push_back(regions.solid_keys[i] + ": " + metres(t) + " thick along " + kAxis[a] +
                       ", thinner than the kernel support " + metres(support) +
                       ": the fluid beside it has fewer wall neighbours than at a full wall and may be pushed "
-                      "through; make it at least " + metres(support) + " thick");
+                      "through; make it at least " +
+                      metres(support) + " thick");
     }
     for (std::size_t j = i + 1; j < s.size(); ++j) {
       const auto [gap, axis] = facing_gap<Dim>(s[i], s[j]);
@@ -72,7 +73,8 @@ std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double s
     }
     if (!regions.container_key.empty() && regions.container)
       for (std::size_t a = 0; a < Dim; ++a)
-        for (const double gap : {s[i].lo[a] - regions.container->lo[a], regions.container->hi[a] - s[i].hi[a]})
+        for (const double gap :
+             {s[i].lo[a] - regions.container->lo[a], regions.container->hi[a] - s[i].hi[a]})
           if (gap > 0 && gap < 2 * spacing)
             out.push_back(gap_warning(regions.solid_keys[i], regions.container_key, gap, a, spacing));
   }

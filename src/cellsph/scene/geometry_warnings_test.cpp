@@ -36,8 +36,8 @@ TEST(GeometryWarnings, WellResolvedGeometryIsQuiet) {
 TEST(GeometryWarnings, ANarrowGapBetweenObstaclesNamesBoth) {
   const auto w = warnings_of(nlohmann::json::array({box(0.2, 0, 0.3, 0.3), box(0.33, 0, 0.43, 0.3)}));
   ASSERT_EQ(w.size(), 1U);
-  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0 and /boundary/obstacles/1: a gap of 0.03 m along x (1.5 spacings)",
-                       0),
+  EXPECT_EQ(w[0].rfind(
+                "/boundary/obstacles/0 and /boundary/obstacles/1: a gap of 0.03 m along x (1.5 spacings)", 0),
             0U)
       << w[0];
   EXPECT_NE(w[0].find("at most 0.015 m"), std::string::npos) << w[0];
@@ -53,8 +53,9 @@ TEST(GeometryWarnings, AnObstacleThinnerThanTheSupport) {
   // 0.03 m thick along x (1.5 spacings, under the 0.04 m support); 0.3 m along y.
   const auto w = warnings_of(nlohmann::json::array({box(0.5, 0, 0.53, 0.3)}));
   ASSERT_EQ(w.size(), 1U);
-  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0: 0.03 m thick along x, thinner than the kernel support 0.04 m", 0),
-            0U)
+  EXPECT_EQ(
+      w[0].rfind("/boundary/obstacles/0: 0.03 m thick along x, thinner than the kernel support 0.04 m", 0),
+      0U)
       << w[0];
 }
 

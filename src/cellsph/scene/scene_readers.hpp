@@ -93,10 +93,10 @@ struct PhaseTable {
 // The regions the fluid blocks are checked against.
 template <int Dim>
 struct Regions {
-  std::vector<Aabb<Dim>> solids;       // regions fluid must not overlap
+  std::vector<Aabb<Dim>> solids;        // regions fluid must not overlap
   std::vector<std::string> solid_keys;  // their key paths, for messages
-  std::optional<Aabb<Dim>> container;  // region fluid must lie in
-  std::string container_key;           // the walls' key path when walls make it (box or walls)
+  std::optional<Aabb<Dim>> container;   // region fluid must lie in
+  std::string container_key;            // the walls' key path when walls make it (box or walls)
   // Shaped obstacles and containers (boundary.obstacles with "mesh", "sphere" or "cylinder"): fluid
   // particles keep half a spacing outside every obstacle and inside some container.
   std::vector<geometry::Shape> solid_shapes, container_shapes;
@@ -188,6 +188,12 @@ std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverC
 // sentence each, naming the keys; nothing is changed.
 template <int Dim>
 std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double spacing, double support);
+
+// How deep inside a wall or obstacle a fluid particle may end a step, and how far on the fluid side of
+// its surface it is put back, in spacings (solver/boundary/solid_guard.hpp): the first layer of wall
+// particles, and the surface itself.
+inline constexpr double kGuardDepth = 0.5;
+inline constexpr double kGuardMargin = 0.0;
 
 // /output, and the box drawn in pictures (output_reader.cpp).
 template <int Dim>

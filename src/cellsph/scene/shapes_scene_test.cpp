@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/parallel.hpp"
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/probes/probes.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"

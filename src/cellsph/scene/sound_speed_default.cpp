@@ -34,7 +34,7 @@ struct FluidDrop {
 
 template <int Dim, class Real>
 FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p,
-                                const std::array<double, 3>& up) {
+                     const std::array<double, 3>& up) {
   const auto height = [&up](const Vec<Dim, Real>& x) {
     double h = 0;
     for (int a = 0; a < Dim; ++a) h += up[static_cast<std::size_t>(a)] * double(x[a]);
@@ -87,21 +87,21 @@ std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverC
       rho0 = std::max(rho0, double(cfg.phases[static_cast<std::size_t>(p.phase[i])].rest_density));
   const double height = drop.top - drop.lowest;
   if (!(g > 0) || !(rho0 > 0) || !(height > 0) || !std::isfinite(height)) {
-    d.why = std::string(!(g > 0)     ? "no gravity"
-                        : rho0 <= 0  ? "no fluid at the start"
-                                     : "no wall below the fluid") +
+    d.why = std::string(!(g > 0)    ? "no gravity"
+                        : rho0 <= 0 ? "no fluid at the start"
+                                    : "no wall below the fluid") +
             " to derive it from: the fixed default; set /solver/eos/stiffness";
     return d;
   }
   const double c = 10 * std::sqrt(2 * g * height);
   cfg.eos.stiffness = cfg.eos.stiffness_for_sound_speed(static_cast<Real>(c), static_cast<Real>(rho0));
   d.value = double(cfg.eos.stiffness);
-  d.why = "speed of sound c = 10 sqrt(2 g H) = " + number_text("%.3g", c) + " m/s, H = " +
-          number_text("%.3g", height) + " m from the fluid's top to the lowest wall";
+  d.why = "speed of sound c = 10 sqrt(2 g H) = " + number_text("%.3g", c) +
+          " m/s, H = " + number_text("%.3g", height) + " m from the fluid's top to the lowest wall";
   return d;
 }
 
-#define CELLSPH_SOUND_SPEED_INSTANTIATE(D, R)                                                           \
+#define CELLSPH_SOUND_SPEED_INSTANTIATE(D, R)                                                                \
   template std::optional<DerivedSetting> default_stiffness<D, R>(const nlohmann::json&, SolverConfig<D, R>&, \
                                                                  const Particles<D, R>&);
 CELLSPH_SOUND_SPEED_INSTANTIATE(2, float)

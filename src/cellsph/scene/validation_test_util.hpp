@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/parallel.hpp"
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/probes/probes.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"

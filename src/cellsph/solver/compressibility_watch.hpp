@@ -24,7 +24,8 @@ class CompressibilityWatch {
  public:
   // The warnings the particles at time t call for that were not given before (none for DFSPH and IISPH,
   // whose pressure solve bounds the density error itself).
-  std::vector<std::string> check(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p, double t) {
+  std::vector<std::string> check(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p,
+                                 double t) {
     std::vector<std::string> out;
     if (cfg.model == Model::Dfsph || cfg.model == Model::Iisph) return out;
     const std::vector<PhaseState> st = phase_states(cfg, p);
@@ -32,8 +33,9 @@ class CompressibilityWatch {
       if (st[k].count == 0) continue;
       const double c = double(cfg.eos.sound_speed(cfg.phases[k].rest_density));
       const std::string who = "phase " + std::to_string(k) + " (" + cfg.phases[k].name + ")";
-      const std::string fix = "raise /solver/eos/stiffness (now " + number("%.4g", double(cfg.eos.stiffness)) +
-                              ", speed of sound " + number("%.3g", c) + " m/s)";
+      const std::string fix = "raise /solver/eos/stiffness (now " +
+                              number("%.4g", double(cfg.eos.stiffness)) + ", speed of sound " +
+                              number("%.3g", c) + " m/s)";
       const double mean = st[k].compression_sum / double(st[k].count);
       if (!mean_ && mean > kWarnMeanCompression) {
         mean_ = true;
@@ -41,13 +43,15 @@ class CompressibilityWatch {
       }
       if (!max_ && st[k].compression_max > kWarnMaxCompression) {
         max_ = true;
-        add(out, t, who + ": largest density " + percent(st[k].compression_max) + " above rest (over 3%): " + fix);
+        add(out, t,
+            who + ": largest density " + percent(st[k].compression_max) + " above rest (over 3%): " + fix);
       }
       const double mach = std::sqrt(st[k].speed2_max) / c;
       if (!mach_ && mach > kWarnMach) {
         mach_ = true;
-        add(out, t, who + ": Mach number " + number("%.2g", mach) + " (fastest particle " +
-                        number("%.3g", std::sqrt(st[k].speed2_max)) + " m/s; over 0.1): " + fix);
+        add(out, t,
+            who + ": Mach number " + number("%.2g", mach) + " (fastest particle " +
+                number("%.3g", std::sqrt(st[k].speed2_max)) + " m/s; over 0.1): " + fix);
       }
     }
     return out;
@@ -62,13 +66,15 @@ class CompressibilityWatch {
     double compression_sum = 0, compression_max = 0, speed2_max = 0;
   };
 
-  static std::vector<PhaseState> phase_states(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p) {
+  static std::vector<PhaseState> phase_states(const SolverConfig<Dim, Real>& cfg,
+                                              const Particles<Dim, Real>& p) {
     std::vector<PhaseState> st(cfg.phases.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (p.kind[i] != std::uint8_t(ParticleKind::Fluid)) continue;
       auto& s = st[static_cast<std::size_t>(p.phase[i])];
       const double rho0 = double(cfg.phases[static_cast<std::size_t>(p.phase[i])].rest_density);
-      const double e = std::max(double(p.rho[i]) / rho0 - 1, 0.0);  // the deficit at a free surface is no error
+      const double e =
+          std::max(double(p.rho[i]) / rho0 - 1, 0.0);  // the deficit at a free surface is no error
       ++s.count;
       s.compression_sum += e;
       s.compression_max = std::max(s.compression_max, e);

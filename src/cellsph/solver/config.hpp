@@ -134,6 +134,25 @@ struct Plane {
   Real offset = 0;
 };
 
+// A box obstacle at rest that the solid guard keeps the fluid out of (boundary/solid_guard.hpp).
+template <int Dim, class Real>
+struct GuardBox {
+  Vec<Dim, Real> lo{}, hi{};
+};
+
+// The solids no fluid particle may end a step inside (boundary/solid_guard.hpp): the tank of
+// boundary.walls and the box obstacles at rest, and the distance kept from their surfaces.
+template <int Dim, class Real>
+struct SolidGuard {
+  bool container = false;  // boundary.walls: the fluid stays inside [lo, hi]
+  Vec<Dim, Real> lo{}, hi{};
+  int open_axis = -1;  // the open top: no wall on the hi face of this axis; -1: closed
+  std::vector<GuardBox<Dim, Real>> boxes{};
+  Real depth = 0;   // how deep inside a solid a particle may end a step [m]
+  Real margin = 0;  // how far on the fluid side of the surface it is put back [m]
+  [[nodiscard]] bool any() const { return container || !boxes.empty(); }
+};
+
 template <int Dim, class Real>
 struct SolverConfig {
   using V = Vec<Dim, Real>;
@@ -204,6 +223,8 @@ struct SolverConfig {
   // particle's viscosity against a wall at rest, as between two fluid particles).
   bool no_slip = false;
   WallModel wall_model = WallModel::Akinci;
+  // Fluid particles put back out of the walls and obstacles they would end a step inside.
+  SolidGuard<Dim, Real> guard{};
   // Moving walls (boundary/wall_motion.hpp; scene key boundary.obstacles[k].motion): the prescribed
   // motions and which boundary particle each moves. Empty: every wall at rest. CPU steps only.
   WallMotions wall_motion{};

@@ -18,6 +18,7 @@
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/solver/boundary/akinci2012.hpp"
 #include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
+#include "cellsph/solver/boundary/solid_guard.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/boundary/wall_states.hpp"
 #include "cellsph/solver/cell_order.hpp"
@@ -465,11 +466,12 @@ std::vector<std::string> Simulation<Dim, Real>::solver_summary() const {
   return stepper_->summary(dfsph_stats(), timings_.neighbors);
 }
 
-// The box and the planes (integration/collisions.hpp).
+// The box and the planes (integration/collisions.hpp), then the solid guard (boundary/solid_guard.hpp).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::apply_walls() {
-  if (!cfg_.box.enabled && cfg_.planes.empty()) return;
-  run_pass(fluid_, box_plane_collisions(cfg_, view()));
+  if (cfg_.box.enabled || !cfg_.planes.empty()) run_pass(fluid_, box_plane_collisions(cfg_, view()));
+  if (cfg_.guard.any())
+    wall_corrections_ += static_cast<std::uint64_t>(reduce_sum(fluid_, solid_guard(cfg_.guard, view())));
 }
 
 // After each step: the first particle (lowest index) with a non-finite quantity or outside the domain
@@ -970,6 +972,7 @@ void Simulation<Dim, Real>::step_device() {
     report_diverged_solve(e);
   }
   clock_.started = r.leapfrog_started;
+  wall_corrections_ += static_cast<std::uint64_t>(r.guard_corrections);
   host_stale_ = true;
   timings_.neighbors += r.neighbors_ms;
   timings_.forces += r.forces_ms;

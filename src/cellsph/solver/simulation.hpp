@@ -107,6 +107,9 @@ class Simulation {
 
   [[nodiscard]] Real time() const { return time_; }
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
+  // Fluid particles put back out of a wall or obstacle they would have ended a step inside, since this
+  // Simulation was made (boundary/solid_guard.hpp; not checkpointed: a resume counts from 0).
+  [[nodiscard]] std::uint64_t wall_corrections() const { return wall_corrections_; }
   [[nodiscard]] Real last_dt() const { return clock_.last_dt; }
   // In the internal (cell) order: see "Particle order" above; particles().id names each particle.
   // With a device backend the particles are copied back here, only when the device holds newer ones
@@ -314,6 +317,7 @@ class Simulation {
   Real time_ = 0;
   LeapFrogClock<Real> clock_;  // the last step, and whether v holds v(t - dt/2) (the paper's leap-frog)
   std::uint64_t steps_ = 0;
+  std::uint64_t wall_corrections_ = 0;
 
   StepTimings timings_;
 

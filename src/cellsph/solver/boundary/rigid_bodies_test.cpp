@@ -15,9 +15,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cellsph/core/test_paths.hpp"
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
+#include "cellsph/core/test_paths.hpp"
 #include "cellsph/io/io_test_util.hpp"
 #include "cellsph/io/simulation_checkpoint.hpp"
 #include "cellsph/scene/scene.hpp"

@@ -19,6 +19,7 @@
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/timer.hpp"
+#include "cellsph/solver/boundary/solid_guard.hpp"
 #include "cellsph/solver/boundary/wall_motion.hpp"
 #include "cellsph/solver/boundary/wall_states.hpp"
 #include "cellsph/solver/config.hpp"
@@ -111,6 +112,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     }
     phases_.upload(params.data(), params.size());
     planes_.upload(cfg_.planes.data(), cfg_.planes.size());
+    guard_boxes_.upload(cfg_.guard.boxes.data(), cfg_.guard.boxes.size());
     motions_.upload(cfg_.wall_motion.motions.data(), cfg_.wall_motion.motions.size());
     motion_rows_.upload(cfg_.wall_motion.rows.data(), cfg_.wall_motion.rows.size());
     std::vector<EmitterPlane<Dim, Real>> emitters;
@@ -223,6 +225,11 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       auto walls = box_plane_collisions(cfg_, pv);
       walls.planes = planes_.data();  // the device's copy of cfg.planes
       run_pass(fluid, walls);
+    }
+    if (cfg_.guard.any()) {
+      auto guard = solid_guard(cfg_.guard, pv);
+      guard.boxes = guard_boxes_.data();  // the device's copy of cfg.guard.boxes
+      r.guard_corrections = reduce_sum(fluid, guard);
     }
     r.first_bad = first_where(fluid, stability_check(cfg_, pv));
     // The walls where the next step sees them, at the Simulation's new time (time_ += dt, in Real).
@@ -399,6 +406,7 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   DeviceParticles<Dim, Real, Space> d_;
   Array<PhaseParams<Real>> phases_;
   Array<Plane<Dim, Real>> planes_;
+  Array<GuardBox<Dim, Real>> guard_boxes_;
   Array<std::uint32_t> fluid_, boundary_, identity_;
   std::vector<std::uint32_t> fluid_host_;
   // The model's stepper (models/model_registry.hpp), which owns the arrays only its model reads, and the

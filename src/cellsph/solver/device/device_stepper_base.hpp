@@ -25,6 +25,7 @@ struct DeviceStepResult {
   double forces_ms = 0;
   double integration_ms = 0;
   bool leapfrog_started = false;  // the paper's leap-frog after the step (LeapFrogClock::started)
+  double guard_corrections = 0;   // fluid particles put back out of solids (boundary/solid_guard.hpp)
 };
 
 // What a step needs of the Simulation's state: the clock (moving walls), the paper's leap-frog clock, and
