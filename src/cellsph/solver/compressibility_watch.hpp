@@ -50,7 +50,7 @@ class CompressibilityWatch {
       if (!mach_ && mach > kWarnMach) {
         mach_ = true;
         add(out, t,
-            who + ": Mach number " + number("%.2g", mach) + " (fastest particle " +
+            who + ": Mach number " + number("%.3g", mach) + " (fastest particle " +
                 number("%.3g", std::sqrt(st[k].speed2_max)) + " m/s; over 0.1): " + fix);
       }
     }
