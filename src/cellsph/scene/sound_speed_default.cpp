@@ -73,7 +73,7 @@ FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Re
 template <int Dim, class Real>
 std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverConfig<Dim, Real>& cfg,
                                                 const Particles<Dim, Real>& p) {
-  if (stiffness_given(j) || cfg.model == Model::Dfsph || cfg.model == Model::Iisph) return std::nullopt;
+  if (stiffness_given(j) || implicit_pressure(cfg.model)) return std::nullopt;
   DerivedSetting d{"/solver/eos/stiffness", double(cfg.eos.stiffness), ""};
   double g = 0;
   for (int a = 0; a < Dim; ++a) g += double(cfg.gravity[a]) * double(cfg.gravity[a]);

@@ -27,7 +27,7 @@ class CompressibilityWatch {
   std::vector<std::string> check(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p,
                                  double t) {
     std::vector<std::string> out;
-    if (cfg.model == Model::Dfsph || cfg.model == Model::Iisph) return out;
+    if (implicit_pressure(cfg.model)) return out;
     const std::vector<PhaseState> st = phase_states(cfg, p);
     for (std::size_t k = 0; k < st.size(); ++k) {
       if (st[k].count == 0) continue;
