@@ -17,11 +17,12 @@
 //
 // Speed: the candidates of a home cell (its mask cells, adjacent ones merged) are copied once into
 // a contiguous block shared by the cell's particles; each particle tests the block 8 (AVX2) or 4
-// (SSE2) at a time, in float whatever Real is (a double search keeps its positions in float too,
-// half the bytes), and walks the set bits of the hit mask, with no branch per candidate. find_all
-// counts, keeping every particle's hit masks (blocks of up to 256 candidates in a work buffer, longer
-// ones in a spill per traversal chunk), then fills the rows from them with no second distance test,
-// and sorts each row of up to 64 in registers (sort_network.hpp), up to 96 by rank.
+// (SSE2) at a time (cell_index_simd.hpp: the loops at each width, chosen at run time), in float whatever Real
+// is (a double search keeps its positions in float too, half the bytes), and walks the set bits of the hit
+// mask, with no branch per candidate. find_all counts, keeping every particle's hit masks (blocks of up to
+// 256 candidates in a work buffer, longer ones in a spill per traversal chunk), then fills the rows from them
+// with no second distance test, and sorts each row of up to 64 in registers (sort_network.hpp), up to 96 by
+// rank.
 //
 // Exactness: the neighbour test is distance2(x[i], x[j]) <= h[i]^2 in Real, the same expression as
 // the all-pairs reference; the mask only decides which candidates reach that test, and it is built
@@ -47,146 +48,17 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
-// SIMD paths: SSE2 (x86-64 baseline) and AVX2 (run-time dispatch). CELLSPH_NO_SIMD forces the
-// scalar code, CELLSPH_NO_AVX2 stops at SSE2 (build the tests with either to check that path).
-#if defined(__SSE2__) && !defined(CELLSPH_NO_SIMD)
-#include <emmintrin.h>
-#define CELLSPH_CELL_INDEX_SSE2 1
-#endif
-#if defined(CELLSPH_CELL_INDEX_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(CELLSPH_NO_AVX2)
-#include <immintrin.h>
-#define CELLSPH_CELL_INDEX_AVX2 1
-#endif
-
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/fresh_memory.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/vec.hpp"
+#include "cellsph/neighbors/cell_index_simd.hpp"
 #include "cellsph/neighbors/csr_builder.hpp"
 #include "cellsph/neighbors/hmask.hpp"
 #include "cellsph/neighbors/neighbor_list.hpp"
 #include "cellsph/neighbors/radix_sort.hpp"
-#include "cellsph/neighbors/sort_network.hpp"
 
 namespace cellsph {
-
-namespace detail {
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-// AVX2 versions of CellIndex's two inner loops, chosen at run time when the CPU has AVX2 (the
-// build targets baseline x86-64). Same operations in the same order as the scalar and SSE2 code
-// (no FMA), so every result is identical whichever path runs.
-inline bool cpu_has_avx2() {
-  return __builtin_cpu_supports("avx2");
-}
-
-// Bits t < m <= 64 with d2 <= hi2, d2 the float distance2 of xi and candidate t of ax; with Band,
-// *sure gets those with d2 <= lo2 (CellIndex::hits64 says why two bounds).
-template <int Dim, bool Band>
-__attribute__((target("avx2"))) std::uint64_t hits64_avx2(const float* const* ax, const float* xi, float lo2,
-                                                          float hi2, std::uint32_t m, std::uint64_t* sure) {
-  std::uint64_t bits = 0, in = 0;
-  const __m256 h2 = _mm256_set1_ps(hi2), l2 = _mm256_set1_ps(lo2);
-  for (std::uint32_t t = 0; t < m; t += 8) {
-    __m256 d = _mm256_sub_ps(_mm256_set1_ps(xi[0]), _mm256_loadu_ps(ax[0] + t));
-    __m256 s2 = _mm256_mul_ps(d, d);
-    for (int k = 1; k < Dim; ++k) {
-      d = _mm256_sub_ps(_mm256_set1_ps(xi[k]), _mm256_loadu_ps(ax[k] + t));
-      s2 = _mm256_add_ps(s2, _mm256_mul_ps(d, d));
-    }
-    bits |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, h2, _CMP_LE_OQ))) << t;
-    if constexpr (Band)
-      in |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_cmp_ps(s2, l2, _CMP_LE_OQ))) << t;
-  }
-  const std::uint64_t all = m == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << m) - 1;
-  if constexpr (Band) *sure = in & all;
-  return bits & all;
-}
-
-// Permutations that move the lanes set in an 8-bit mask to the front, in order (left-packing).
-struct LeftPackTable {
-  alignas(32) std::uint32_t lane[256][8];
-  std::uint8_t count[256];
-  constexpr LeftPackTable() : lane{}, count{} {
-    for (int m = 0; m < 256; ++m) {
-      int c = 0;
-      for (int t = 0; t < 8; ++t)
-        if ((m >> t) & 1) lane[m][c++] = static_cast<std::uint32_t>(t);
-      count[m] = static_cast<std::uint8_t>(c);
-    }
-  }
-};
-inline constexpr LeftPackTable kLeftPack{};
-
-// Writes id[t] for every bit t set in bits (t < m <= 64) to dst, in order; returns how many. Writes
-// up to 8 entries past the last one and reads up to 8 past id[m - 1] (both must be padding).
-__attribute__((target("avx2"))) inline std::uint32_t left_pack_avx2(const std::uint32_t* id,
-                                                                    std::uint64_t bits, std::uint32_t m,
-                                                                    std::uint32_t* dst) {
-  std::uint32_t c = 0;
-  for (std::uint32_t t = 0; t < m && (bits >> t) != 0; t += 8) {
-    const auto k = static_cast<unsigned>((bits >> t) & 0xFFu);
-    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(id + t));
-    const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(kLeftPack.lane[k]));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + c), _mm256_permutevar8x32_epi32(v, perm));
-    c += kLeftPack.count[k];
-  }
-  return c;
-}
-
-// Ranks of the NB * 8 values biased[k0, k0 + 8 NB) among biased[0, L): each biased[m] is broadcast
-// once and compared with all NB registers, whose NB sums are independent (no one chain of L adds).
-template <int NB>
-__attribute__((target("avx2"))) inline void rank_block_avx2(const std::int32_t* biased, std::uint32_t L,
-                                                            std::uint32_t k0, std::uint32_t* rank) {
-  __m256i v[NB], acc[NB];
-  for (int b = 0; b < NB; ++b) {
-    v[b] = _mm256_load_si256(reinterpret_cast<const __m256i*>(biased + k0 + 8 * b));
-    acc[b] = _mm256_setzero_si256();
-  }
-  for (std::uint32_t m = 0; m < L; ++m) {
-    const __m256i w = _mm256_set1_epi32(biased[m]);
-    for (int b = 0; b < NB; ++b) acc[b] = _mm256_sub_epi32(acc[b], _mm256_cmpgt_epi32(v[b], w));
-  }
-  for (int b = 0; b < NB; ++b) _mm256_store_si256(reinterpret_cast<__m256i*>(rank + 8 * b), acc[b]);
-}
-
-// Sorts the distinct in[0, L) (L <= kMax) into out by rank, out[#{m : in[m] < in[k]}] = in[k], eight
-// values of k to a register and up to four registers at a time: each in[m] is broadcast once and
-// compared with all of them, so the ranks come out in registers, with no horizontal sum. Reads up to
-// 8 entries past in[L - 1].
-template <std::uint32_t kMax>
-__attribute__((target("avx2"))) inline void rank_sort_avx2(const std::uint32_t* in, std::uint32_t L,
-                                                           std::uint32_t* out) {
-  // Unsigned order through the signed compare: flip the top bit of every value once. Entries past L
-  // (up to the next 32) are read as a block's padding; their ranks are never used.
-  alignas(32) std::int32_t biased[kMax + 32];
-  const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
-  std::uint32_t m = 0;
-  for (; m < L; m += 8)
-    _mm256_store_si256(reinterpret_cast<__m256i*>(biased + m),
-                       _mm256_xor_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + m)), bias));
-  for (; m < ((L + 31) & ~31u); m += 8) _mm256_store_si256(reinterpret_cast<__m256i*>(biased + m), bias);
-  alignas(32) std::uint32_t rank[32];
-  for (std::uint32_t k0 = 0; k0 < L; k0 += 32) {
-    const std::uint32_t left = L - k0;
-    if (left > 24)
-      rank_block_avx2<4>(biased, L, k0, rank);
-    else if (left > 16)
-      rank_block_avx2<3>(biased, L, k0, rank);
-    else if (left > 8)
-      rank_block_avx2<2>(biased, L, k0, rank);
-    else
-      rank_block_avx2<1>(biased, L, k0, rank);
-    const std::uint32_t e = std::min<std::uint32_t>(32, left);
-    for (std::uint32_t t = 0; t < e; ++t) out[rank[t]] = in[k0 + t];
-  }
-}
-#else
-inline bool cpu_has_avx2() {
-  return false;
-}
-#endif
-}  // namespace detail
 
 template <int Dim, class Real>
 class CellIndex {
@@ -672,8 +544,8 @@ class CellIndex {
   // Sorts the distinct values in[0, L) (L <= kRankSortMax) into out: rows of up to 64 with a sorting
   // network where AVX2 is, others by rank. in must have room for kRankSortMax + 8 entries.
   void sort_row(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) const {
-#if defined(CELLSPH_SORT_NETWORK_AVX2) && defined(CELLSPH_CELL_INDEX_AVX2)
-    if (avx2_ && L <= 64) {
+#if defined(CELLSPH_CELL_INDEX_X86)
+    if (simd_ == SimdPath::Avx2 && L <= 64) {
       if (L > 0) detail::sort_row_avx2(in, L, out);
       return;
     }
@@ -686,32 +558,11 @@ class CellIndex {
   // room for 8 entries past L (overwritten).
   void rank_sort(std::uint32_t* in, std::uint32_t L, std::uint32_t* out) const {
     for (std::uint32_t t = L; t < L + 8; ++t) in[t] = std::numeric_limits<std::uint32_t>::max();
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-    if (avx2_) {
-      detail::rank_sort_avx2<kRankSortMax>(in, L, out);
-      return;
-    }
+#if defined(CELLSPH_CELL_INDEX_X86)
+    if (simd_ == SimdPath::Avx2) return detail::rank_sort_avx2<kRankSortMax>(in, L, out);
+    if (simd_ == SimdPath::Sse2) return detail::rank_sort_sse2(in, L, out);
 #endif
-#if defined(CELLSPH_CELL_INDEX_SSE2)
-    const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));  // unsigned order via signed compare
-    for (std::uint32_t k = 0; k < L; ++k) {
-      const __m128i v = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(in[k])), bias);
-      __m128i acc = _mm_setzero_si128();
-      for (std::uint32_t m = 0; m < L; m += 4) {
-        const __m128i w = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + m)), bias);
-        acc = _mm_sub_epi32(acc, _mm_cmplt_epi32(w, v));
-      }
-      acc = _mm_add_epi32(acc, _mm_shuffle_epi32(acc, 0x4E));
-      acc = _mm_add_epi32(acc, _mm_shuffle_epi32(acc, 0xB1));
-      out[_mm_cvtsi128_si32(acc)] = in[k];
-    }
-#else
-    for (std::uint32_t k = 0; k < L; ++k) {
-      std::uint32_t rank = 0;
-      for (std::uint32_t m = 0; m < L; ++m) rank += in[m] < in[k] ? 1u : 0u;
-      out[rank] = in[k];
-    }
-#endif
+    detail::rank_sort_scalar(in, L, out);
   }
 
   // A particle's candidates copied side by side, so that the distance loop runs over one
@@ -923,8 +774,8 @@ class CellIndex {
   std::uint32_t pack_hits(const std::uint64_t* bits, const Block& blk, std::uint32_t* dst) const {
     std::uint32_t c = 0;
     for (std::uint32_t b = 0, w = 0; b < blk.n; b += 64, ++w) {
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-      if (avx2_) {
+#if defined(CELLSPH_CELL_INDEX_X86)
+      if (simd_ == SimdPath::Avx2) {
         c += detail::left_pack_avx2(blk.id + b, bits[w], std::min<std::uint32_t>(64, blk.n - b), dst + c);
         continue;
       }
@@ -977,37 +828,11 @@ class CellIndex {
   template <bool Band>
   std::uint64_t float_hits(const float* const* ax, const float* xi, float lo2, float hi2, std::uint32_t m,
                            std::uint64_t* sure) const {
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-    if (avx2_) return detail::hits64_avx2<Dim, Band>(ax, xi, lo2, hi2, m, sure);
+#if defined(CELLSPH_CELL_INDEX_X86)
+    if (simd_ == SimdPath::Avx2) return detail::hits64_avx2<Dim, Band>(ax, xi, lo2, hi2, m, sure);
+    if (simd_ == SimdPath::Sse2) return detail::hits64_sse2<Dim, Band>(ax, xi, lo2, hi2, m, sure);
 #endif
-    std::uint64_t bits = 0, in = 0;
-#if defined(CELLSPH_CELL_INDEX_SSE2)
-    const __m128 h2 = _mm_set1_ps(hi2), l2 = _mm_set1_ps(lo2);
-    for (std::uint32_t t = 0; t < m; t += 4) {
-      __m128 d = _mm_sub_ps(_mm_set1_ps(xi[0]), _mm_loadu_ps(ax[0] + t));
-      __m128 s2 = _mm_mul_ps(d, d);
-      for (int k = 1; k < Dim; ++k) {
-        d = _mm_sub_ps(_mm_set1_ps(xi[k]), _mm_loadu_ps(ax[k] + t));
-        s2 = _mm_add_ps(s2, _mm_mul_ps(d, d));
-      }
-      bits |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, h2))) << t;
-      if constexpr (Band) in |= static_cast<std::uint64_t>(_mm_movemask_ps(_mm_cmple_ps(s2, l2))) << t;
-    }
-#else
-    for (std::uint32_t t = 0; t < m; ++t) {
-      float d = xi[0] - ax[0][t];
-      float s2 = d * d;
-      for (int k = 1; k < Dim; ++k) {
-        d = xi[k] - ax[k][t];
-        s2 += d * d;
-      }
-      bits |= static_cast<std::uint64_t>(s2 <= hi2) << t;
-      if constexpr (Band) in |= static_cast<std::uint64_t>(s2 <= lo2) << t;
-    }
-#endif
-    const std::uint64_t all = m == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << m) - 1;
-    if constexpr (Band) *sure = in & all;
-    return bits & all;
+    return detail::hits64_scalar<Dim, Band>(ax, xi, lo2, hi2, m, sure);
   }
 
   // Float bounds around h^2 for a double search (hits64): a float distance2 at or below lo2 is
@@ -1244,8 +1069,8 @@ class CellIndex {
 
   int subdivision_ = 1;
   bool sorted_rows_ = true;
-  bool zero_rows_ = true;  // SearchOptions::zero_support_rows
-  bool avx2_ = detail::cpu_has_avx2();
+  bool zero_rows_ = true;        // SearchOptions::zero_support_rows
+  SimdPath simd_ = simd_path();  // the width of the inner loops (cell_index_simd.hpp)
   bool force_wide_ = false;
   std::uint32_t kept_order_max_ = kKeptOrderMax;
   std::size_t n_ = 0;

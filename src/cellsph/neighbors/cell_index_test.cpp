@@ -436,32 +436,103 @@ TEST(CellIndex, ZeroSupportRowsLeftEmptyOnRequestDouble) {
   return v;
 }
 
-#if defined(CELLSPH_CELL_INDEX_AVX2)
-// The AVX2 rank sort that orders short rows, on every length up to its limit (one to four registers a
-// block, one to three blocks), distinct values on both sides of 2^31 (the signed compare's bias),
-// against std::sort.
-TEST(CellIndex, RankSortOrdersEveryRowLength) {
-  if (!detail::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: the portable sort runs instead";
-  std::mt19937 rng(96);
-  for (std::uint32_t L = 1; L <= 96; ++L)
-    for (int rep = 0; rep < 20; ++rep) {
-      std::vector<std::uint32_t> v = distinct_values(rng, L, rep, 200);
-      std::vector<std::uint32_t> in(v);
-      in.resize(L + 8, 0xFFFFFFFFu);  // the 8 entries past L it may read
-      std::vector<std::uint32_t> out(L, 0);
-      detail::rank_sort_avx2<96>(in.data(), L, out.data());
-      std::sort(v.begin(), v.end());
-      ASSERT_EQ(out, v) << "L = " << L << ", rep " << rep;
+// The rank sorts that order short rows at each width the CPU has, on every length up to the limit (for
+// AVX2 one to four registers a block, one to three blocks), distinct values on both sides of 2^31 (the
+// signed compare's bias), against std::sort.
+TEST(CellIndex, RankSortOrdersEveryRowLengthAtEveryWidth) {
+  for (SimdPath path : {SimdPath::Scalar, SimdPath::Sse2, SimdPath::Avx2}) {
+    if (path > best_simd_path()) continue;  // this CPU cannot run it (said below)
+    std::mt19937 rng(96);
+    for (std::uint32_t L = 1; L <= 96; ++L)
+      for (int rep = 0; rep < 20; ++rep) {
+        std::vector<std::uint32_t> v = distinct_values(rng, L, rep, 200);
+        std::vector<std::uint32_t> in(v);
+        in.resize(L + 8, 0xFFFFFFFFu);  // the 8 entries past L it may read
+        std::vector<std::uint32_t> out(L, 0);
+        if (path == SimdPath::Scalar) detail::rank_sort_scalar(in.data(), L, out.data());
+#if defined(CELLSPH_CELL_INDEX_X86)
+        if (path == SimdPath::Sse2) detail::rank_sort_sse2(in.data(), L, out.data());
+        if (path == SimdPath::Avx2) detail::rank_sort_avx2<96>(in.data(), L, out.data());
+#endif
+        std::sort(v.begin(), v.end());
+        ASSERT_EQ(out, v) << simd_path_name(path) << ", L = " << L << ", rep " << rep;
+      }
+  }
+  if (best_simd_path() != SimdPath::Avx2) GTEST_SKIP() << "this CPU has no AVX2: its rank sort was not run";
+}
+
+// The distance tests of a block at each width give the scalar loop's bits, both bounds, at every block
+// length, in 2D and 3D, with candidates on and around both bounds.
+template <int Dim>
+void expect_hits_alike_at_every_width() {
+  std::mt19937 rng(7 + Dim);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> axis[Dim];
+  for (auto& a : axis) {
+    a.resize(64 + 8);
+    for (float& c : a) c = u(rng);
+  }
+  const float* ax[Dim];
+  for (int k = 0; k < Dim; ++k) ax[k] = axis[k].data();
+  float xi[Dim];
+  for (int k = 0; k < Dim; ++k) xi[k] = axis[k][5];  // candidate 5 sits on xi: d2 = 0
+  float d0 = 0;                                      // candidate 9's d2 exactly, as the loops sum it
+  for (int k = 0; k < Dim; ++k) d0 += (xi[k] - ax[k][9]) * (xi[k] - ax[k][9]);
+  for (std::uint32_t m = 1; m <= 64; ++m)
+    for (float hi2 : {0.0f, d0, 0.3f, 2.0f}) {
+      const float lo2 = hi2 * 0.5f;
+      std::uint64_t sure_ref = 0;
+      const std::uint64_t ref = detail::hits64_scalar<Dim, true>(ax, xi, lo2, hi2, m, &sure_ref);
+      if (m > 9 && hi2 == d0) {
+        ASSERT_TRUE((ref >> 9) & 1u) << "the candidate at exactly hi2 is a hit";
+      }
+#if defined(CELLSPH_CELL_INDEX_X86)
+      std::uint64_t sure = 0;
+      const std::uint64_t sse2 = detail::hits64_sse2<Dim, true>(ax, xi, lo2, hi2, m, &sure);
+      EXPECT_EQ(sse2, ref) << "sse2, m = " << m;
+      EXPECT_EQ(sure, sure_ref) << "sse2, m = " << m;
+      if (best_simd_path() == SimdPath::Avx2) {
+        const std::uint64_t avx2 = detail::hits64_avx2<Dim, true>(ax, xi, lo2, hi2, m, &sure);
+        EXPECT_EQ(avx2, ref) << "avx2, m = " << m;
+        EXPECT_EQ(sure, sure_ref) << "avx2, m = " << m;
+      }
+#endif
     }
 }
-#endif
+
+TEST(CellIndex, DistanceTestsGiveTheScalarBitsAtEveryWidth) {
+  expect_hits_alike_at_every_width<2>();
+  expect_hits_alike_at_every_width<3>();
+}
+
+// CELLSPH_SIMD's values: the three names, empty or unset for the best; anything else, or a path wider
+// than the CPU's, is an input error naming the variable and the value.
+TEST(CellIndex, SimdPathFromTheEnvironmentVariable) {
+  EXPECT_EQ(parse_simd_path(nullptr, SimdPath::Avx2), SimdPath::Avx2);
+  EXPECT_EQ(parse_simd_path("", SimdPath::Sse2), SimdPath::Sse2);
+  EXPECT_EQ(parse_simd_path("scalar", SimdPath::Avx2), SimdPath::Scalar);
+  EXPECT_EQ(parse_simd_path("sse2", SimdPath::Avx2), SimdPath::Sse2);
+  EXPECT_EQ(parse_simd_path("avx2", SimdPath::Avx2), SimdPath::Avx2);
+  try {
+    (void)parse_simd_path("avx512", SimdPath::Avx2);
+    ADD_FAILURE() << "avx512 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("CELLSPH_SIMD=avx512"), std::string::npos) << e.what();
+  }
+  try {
+    (void)parse_simd_path("avx2", SimdPath::Sse2);
+    ADD_FAILURE() << "avx2 accepted on an SSE2-only CPU";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("at most sse2"), std::string::npos) << e.what();
+  }
+}
 
 #if defined(CELLSPH_SORT_NETWORK_AVX2)
 // The bitonic networks that order rows of up to 64 (one, two, four or eight registers), on every
 // length, values across the whole unsigned range, against std::sort. The entries past L that it reads
 // hold small values, which would sort first were they not ignored; nothing past out[L - 1] is written.
 TEST(CellIndex, SortNetworkOrdersEveryRowLength) {
-  if (!detail::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: the rank sort runs instead";
+  if (best_simd_path() != SimdPath::Avx2) GTEST_SKIP() << "this CPU has no AVX2: the rank sort runs instead";
   std::mt19937 rng(64);
   for (std::uint32_t L = 1; L <= 64; ++L)
     for (int rep = 0; rep < 40; ++rep) {

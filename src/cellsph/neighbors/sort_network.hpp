@@ -10,7 +10,7 @@
 // and the work is O(n log^2 n) in registers where the rank sort's is O(n^2 / 8).
 #include <cstdint>
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(CELLSPH_NO_SIMD) && !defined(CELLSPH_NO_AVX2)
+#if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define CELLSPH_SORT_NETWORK_AVX2 1
 
