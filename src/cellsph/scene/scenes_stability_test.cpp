@@ -7,15 +7,14 @@
 // and every physics parameter (stiffness, viscosity, sigma, gravity, restitution, friction, time stepping);
 // only the particle count drops (to ~180-430 fluid particles).
 //
-// Steps: issue 3's 10^4 per scene, in every build: 6.8-20 s of simulated time (the fixed-step scenes
+// Steps: issue 3's 10^4 per scene: 6.8-20 s of simulated time (the fixed-step scenes
 // 20 s, the Courant-stepped 2D ones 6.8-9 s, dam-break-3d 16 s), well past each scene's whole dynamics
 // (collapse, impact, return waves, settling; the Rayleigh-Taylor overturn). Each scene is its own ctest
-// entry (value-parameterised), so `ctest -j2` runs them two at a time. Measured on 2 cores under load
-// (other builds running): release, the 9 scenes 32 s of wall time (dam-break-3d 9-21 s, the paper dam
-// breaks 6-13 s each: 3D with h = 4.7 spacings, ~400 neighbours; the rest 1-3 s), the whole release suite 35
-// s; ASan+UBSan (RelWithDebInfo, ~2.5x slower per step, not 10x), the 9 scenes 81 s (dam-break-3d 53 s, the
-// paper dam breaks 25-28 s), the whole ASan suite 134 s. Cheap enough to keep 10^4 under the sanitizers too
-// (300 steps there would save ~75 s), so one step count for both.
+// entry (value-parameterised), so `ctest -j2` runs them two at a time. Measured in CI's fresh clone (2
+// cores, 20 scenes): release 6-9 s each for the six 3D ones below, 4 s for oil-glass, 0.7-3.2 s for the 2D
+// ones; under ASan+UBSan at -O1 (scripts/test.sh) 8-40 s for those and 47-102 s for the six 3D ones (the
+// paper's dam breaks, dam-break-3d and its DFSPH twin, spheric-test2), so scripts/test.sh runs those six in
+// the release build only: their code runs under the sanitizers through the 3D solver tests and the 2D scenes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
