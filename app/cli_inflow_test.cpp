@@ -16,17 +16,12 @@
 
 namespace {
 
+using cellsph::test::count_lines;
 using cellsph::test::q;
 using cellsph::test::read_file;
 using cellsph::test::run_cli;
 using cellsph::test::TempDir;
 namespace fs = std::filesystem;
-
-std::size_t count_lines(const std::string& s) {
-  std::size_t n = 0;
-  for (const char c : s) n += c == '\n' ? 1 : 0;
-  return n;
-}
 
 TEST(CliInflow, BadEmittersAndSinksStopTheStartWithOneLine) {
   TempDir dir;

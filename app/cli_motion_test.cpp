@@ -13,18 +13,13 @@
 
 namespace {
 
+using cellsph::test::count_lines;
 using cellsph::test::q;
 using cellsph::test::read_file;
 using cellsph::test::run_cli;
 using cellsph::test::TempDir;
 using cellsph::test::write_file;
 namespace fs = std::filesystem;
-
-std::size_t count_lines(const std::string& s) {
-  std::size_t n = 0;
-  for (const char c : s) n += c == '\n' ? 1 : 0;
-  return n;
-}
 
 // A 2D tank with water pushed by a block (the obstacle) whose motion is MOTION.
 std::string piston_scene(const std::string& motion) {

@@ -36,6 +36,7 @@ extern char** environ;
 
 namespace {
 
+using cellsph::test::count_lines;
 using cellsph::test::q;
 using cellsph::test::read_file;
 using cellsph::test::run_cli;
@@ -88,12 +89,6 @@ std::string differences(const std::map<std::string, std::string>& a,
   for (const auto& [k, v] : b)
     if (!a.count(k)) d += " only-in-second:" + k;
   return d;
-}
-
-std::size_t count_lines(const std::string& s) {
-  std::size_t n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
 }
 
 // The lines that are not warnings (the tiny scene's weak speed of sound is warned before a fault stops it).

@@ -20,7 +20,7 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
 }
 
 template <int Dim, class Real>
-void check_round_trip() {
+void check_checkpoint_round_trip() {
   test::TempDir dir("ckpt");
   auto p = test::make_particles<Dim, Real>(101);
   p.v[5][0] = -Real(0);  // sign of zero and a NaN payload must survive too
@@ -56,10 +56,10 @@ void check_round_trip() {
 }
 
 TEST(Checkpoint, RoundTripIsBitExact2DFloat) {
-  check_round_trip<2, float>();
+  check_checkpoint_round_trip<2, float>();
 }
 TEST(Checkpoint, RoundTripIsBitExact3DDouble) {
-  check_round_trip<3, double>();
+  check_checkpoint_round_trip<3, double>();
 }
 
 // The solver state (solver/particles.hpp) is written after the particle fields and read back bit for bit.

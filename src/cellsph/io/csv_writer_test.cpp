@@ -38,7 +38,7 @@ TEST(CsvWriter, HeaderStartsWithTheContractColumns) {
 }
 
 template <int Dim, class Real>
-void check_round_trip() {
+void check_csv_round_trip() {
   test::TempDir dir("csv");
   const std::size_t n = 20000;  // more than one formatting chunk
   const auto p = test::make_particles<Dim, Real>(n);
@@ -74,10 +74,10 @@ void check_round_trip() {
 }
 
 TEST(CsvWriter, RoundTripsBitExactly2DDouble) {
-  check_round_trip<2, double>();
+  check_csv_round_trip<2, double>();
 }
 TEST(CsvWriter, RoundTripsBitExactly3DFloat) {
-  check_round_trip<3, float>();
+  check_csv_round_trip<3, float>();
 }
 
 TEST(CsvWriter, FilterKeepsOnlySelectedRowsInOrder) {

@@ -63,7 +63,7 @@ TEST(Eos, FormsAndClamp) {
   }
 }
 
-using V3 = Vec<3, double>;
+using V3d = Vec<3, double>;
 
 PairInput<3, double> swap_ij(PairInput<3, double> in) {
   std::swap(in.mi, in.mj);
@@ -84,9 +84,9 @@ TEST(Interactions, PairForcesAreAntisymmetric) {
   const CubicSplineKernel<3, double> cubic(h);
   for (int k = 0; k < 50; ++k) {
     PairInput<3, double> in{};
-    in.xij = V3{{u(gen), u(gen), u(gen)}} * 0.05;
+    in.xij = V3d{{u(gen), u(gen), u(gen)}} * 0.05;
     in.r = norm(in.xij);
-    in.vij = V3{{u(gen), u(gen), u(gen)}};
+    in.vij = V3d{{u(gen), u(gen), u(gen)}};
     in.mi = 1 + 0.5 * u(gen);
     in.mj = 1 + 0.5 * u(gen);
     in.rhoi = 1000 + 50 * u(gen);
@@ -96,7 +96,7 @@ TEST(Interactions, PairForcesAreAntisymmetric) {
     in.mui = 1 + u(gen) / 2;
     in.muj = 1 + u(gen) / 2;
     const auto back = swap_ij(in);
-    auto expect_opposite = [](const V3& a, const V3& b) {
+    auto expect_opposite = [](const V3d& a, const V3d& b) {
       for (int d = 0; d < 3; ++d) EXPECT_NEAR(a[d], -b[d], 1e-12 * (1 + std::abs(a[d])));
     };
     expect_opposite(averaged_pressure_force(in, spiky), averaged_pressure_force(back, spiky));

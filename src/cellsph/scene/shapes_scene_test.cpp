@@ -20,13 +20,13 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kMeshes = fs::path(cellsph::test::source_dir()) / "data" / "meshes";
 
-struct TempDir {
+struct ScratchFolder {
   fs::path path;
-  TempDir() {
+  ScratchFolder() {
     char tmpl[] = "/tmp/cellsph-shapes-XXXXXX";
     path = ::mkdtemp(tmpl);
   }
-  ~TempDir() { fs::remove_all(path); }
+  ~ScratchFolder() { fs::remove_all(path); }
 };
 
 template <int Dim>
@@ -56,7 +56,7 @@ std::string error_of(const std::string& text, int dim, const std::string& source
 // The glass: data/meshes/cylinder.stl (radius 0.5, height 1, 64 segments, about +z from the origin),
 // named relative to the scene file, as a container holding a box of water cut to it.
 TEST(SceneShapes, ContainerMeshHoldsTheFluidHalfASpacingInside) {
-  TempDir dir;
+  ScratchFolder dir;
   fs::create_directories(dir.path / "meshes");
   fs::copy_file(kMeshes / "cylinder.stl", dir.path / "meshes" / "glass.stl");
   const double s = 0.05;
@@ -109,7 +109,7 @@ struct StillGlass {
 const std::vector<double> kGlassHeights{0.04, 0.08, 0.12};
 
 StillGlass still_glass(double spacing, int steps, int average_from) {
-  TempDir dir;
+  ScratchFolder dir;
   fs::copy_file(kMeshes / "cylinder.stl", dir.path / "glass.stl");
   const double R = 0.2, H = 0.25, g = 9.81, rho0 = 1000, c = 10 * std::sqrt(2 * g * H);
   auto j = nlohmann::json::parse(R"({"dimension": 3, "precision": "double",

@@ -26,8 +26,8 @@ constexpr double kSpacing = 0.02;
 constexpr double kRho0 = 1000;
 
 template <int Dim, class Real>
-void add_particle(Particles<Dim, Real>& p, const std::array<double, 3>& x, std::int32_t phase,
-                  ParticleKind kind) {
+void add_test_particle(Particles<Dim, Real>& p, const std::array<double, 3>& x, std::int32_t phase,
+                       ParticleKind kind) {
   const std::size_t i = p.size();
   p.resize(i + 1);
   for (int k = 0; k < Dim; ++k) p.x[i][k] = static_cast<Real>(x[k]);
@@ -51,7 +51,7 @@ Particles<Dim, Real> ball(const std::array<double, 3>& centre, double radius, Ph
         if (d2 > radius * radius) continue;
         const std::array<double, 3> x{centre[0] + a * kSpacing, centre[1] + b * kSpacing,
                                       Dim == 3 ? centre[2] + c * kSpacing : 0.0};
-        add_particle(p, x, phase_of(x), ParticleKind::Fluid);
+        add_test_particle(p, x, phase_of(x), ParticleKind::Fluid);
       }
   return p;
 }
@@ -358,8 +358,8 @@ TEST(Surface, BoundaryParticlesAndEmptyPhasesMakeNoSurface) {
   for (int a = -8; a <= 8; ++a)
     for (int b = -8; b <= 8; ++b)
       for (int c = 0; c < 2; ++c)
-        add_particle(with_wall, {a * kSpacing, b * kSpacing, -0.12 - c * kSpacing}, a < 0 ? 0 : 1,
-                     ParticleKind::Boundary);
+        add_test_particle(with_wall, {a * kSpacing, b * kSpacing, -0.12 - c * kSpacing}, a < 0 ? 0 : 1,
+                          ParticleKind::Boundary);
   test::TempDir dir("surface_boundary");
   const auto paths = write_surfaces(with_wall, {}, dir.path(), 0);
   ASSERT_EQ(paths.size(), 2u);
@@ -378,8 +378,8 @@ TEST(Surface, BoundaryParticlesAndEmptyPhasesMakeNoSurface) {
   }
   // Only boundary particles: no files at all.
   Particles<3, double> walls;
-  add_particle(walls, {0, 0, 0}, 0, ParticleKind::Boundary);
-  add_particle(walls, {kSpacing, 0, 0}, 0, ParticleKind::Boundary);
+  add_test_particle(walls, {0, 0, 0}, 0, ParticleKind::Boundary);
+  add_test_particle(walls, {kSpacing, 0, 0}, 0, ParticleKind::Boundary);
   test::TempDir dir2("surface_walls");
   EXPECT_TRUE(write_surfaces(walls, {}, dir2.path(), 0).empty());
   EXPECT_TRUE(dir2.listing().empty());
@@ -388,7 +388,7 @@ TEST(Surface, BoundaryParticlesAndEmptyPhasesMakeNoSurface) {
 
 TEST(Surface, ALoneParticleBelowTheIsoLevelGivesAnEmptyButValidMesh) {
   Particles<3, double> p;
-  add_particle(p, {0, 0, 0}, 3, ParticleKind::Fluid);  // peak colour s^3 W(0) ~ 0.3 < 1/2
+  add_test_particle(p, {0, 0, 0}, 3, ParticleKind::Fluid);  // peak colour s^3 W(0) ~ 0.3 < 1/2
   test::TempDir dir("surface_lone");
   for (auto format : {SurfaceFormat::Ply, SurfaceFormat::Obj}) {
     SurfaceOptions opt;

@@ -24,7 +24,7 @@ namespace {
 
 using test::same_state;
 using V2 = Vec<2, double>;
-using V3 = Vec<3, float>;
+using V3f = Vec<3, float>;
 
 // Every field holds values that differ per particle and per field.
 Particles<2, double> distinct_particles(std::size_t n) {
@@ -221,14 +221,14 @@ TEST_P(DeviceWalls, HostDeviceStepsAreBitIdenticalToTheCpu3DFloatWithBoxAndPlane
   cfg.eos.clamp_negative = true;
   cfg.time.mode = TimeStepping::Courant;
   cfg.time.dt_max = 1e-3f;
-  cfg.gravity = V3{{0, 0, -9.81f}};
+  cfg.gravity = V3f{{0, 0, -9.81f}};
   cfg.box.enabled = true;
-  cfg.box.lo = V3{{-0.1f, -0.1f, -0.1f}};
-  cfg.box.hi = V3{{0.5f, 0.3f, 0.5f}};
-  cfg.planes.push_back({V3{{1, 0, 0}}, 0.02f});
+  cfg.box.lo = V3f{{-0.1f, -0.1f, -0.1f}};
+  cfg.box.hi = V3f{{0.5f, 0.3f, 0.5f}};
+  cfg.planes.push_back({V3f{{1, 0, 0}}, 0.02f});
   Particles<3, float> p;
-  add_block<3, float>(p, V3{{0, 0, 0}}, V3{{0.2f, 0.2f, 0.3f}}, s, 0);
-  add_box_walls<3, float>(p, V3{{0, 0, 0}}, V3{{0.4f, 0.2f, 0.4f}}, s, 2, true, 0, 1000 * s * s * s);
+  add_block<3, float>(p, V3f{{0, 0, 0}}, V3f{{0.2f, 0.2f, 0.3f}}, s, 0);
+  add_box_walls<3, float>(p, V3f{{0, 0, 0}}, V3f{{0.4f, 0.2f, 0.4f}}, s, 2, true, 0, 1000 * s * s * s);
   expect_same_steps(cfg, p, 25);
 }
 
