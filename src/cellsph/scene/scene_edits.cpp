@@ -52,8 +52,8 @@ std::size_t invalid_utf8_at(std::string_view s) {
 // 30-byte input to fuzz/scene_fuzz.cpp 44 million). One past the end appends, like "-".
 void check_array_indices(const nlohmann::json& j, const std::string& edit, const std::string& pointer) {
   std::vector<std::string> tokens;
-  for (nlohmann::json::json_pointer p(pointer); !p.empty(); p.pop_back())
-    tokens.insert(tokens.begin(), p.back());
+  for (nlohmann::json::json_pointer p(pointer); !p.empty(); p.pop_back()) tokens.push_back(p.back());
+  std::reverse(tokens.begin(), tokens.end());  // root first
   const nlohmann::json* cur = &j;  // nullptr once the path leaves what exists
   std::string path;
   for (const auto& t : tokens) {

@@ -1,4 +1,5 @@
-# cellsph_unity_sources(OUT SOURCES...): the test sources compiled BATCH to a unit. Most of a test unit's
+# cellsph_unity_sources(OUT NAME BATCH SOURCES...): SOURCES compiled BATCH to a unit (the tests; the
+# library's scene readers and writers), the units named NAME_<k>.cpp. Most of a test unit's
 # compile time is the headers it shares with its neighbours (six solver and scene tests: 66 CPU-s one by
 # one, 29 as one unit), so each generated unit includes BATCH of them, in the glob's (folder) order.
 # CMake's own UNITY_BUILD writes absolute paths into its units, which would make every fresh clone miss
@@ -7,7 +8,7 @@
 # own compile definitions (test_paths_test.cpp: the checkout's paths) stay units of their own.
 # A unit is rewritten only when its list changes; editing a test recompiles its unit (the dependency
 # files track the included sources).
-function(cellsph_unity_sources out batch)
+function(cellsph_unity_sources out name batch)
   set(units)
   set(text "")
   set(count 0)
@@ -22,7 +23,7 @@ function(cellsph_unity_sources out batch)
     string(APPEND text "#include \"${rel}\"\n")
     math(EXPR count "${count} + 1")
     if(count EQUAL batch)
-      set(unit ${CMAKE_CURRENT_BINARY_DIR}/unity_tests/unit_${index}.cpp)
+      set(unit ${CMAKE_CURRENT_BINARY_DIR}/unity/${name}_${index}.cpp)
       file(CONFIGURE OUTPUT ${unit} CONTENT "${text}" @ONLY)
       list(APPEND units ${unit})
       math(EXPR index "${index} + 1")
@@ -31,7 +32,7 @@ function(cellsph_unity_sources out batch)
     endif()
   endforeach()
   if(count GREATER 0)
-    set(unit ${CMAKE_CURRENT_BINARY_DIR}/unity_tests/unit_${index}.cpp)
+    set(unit ${CMAKE_CURRENT_BINARY_DIR}/unity/${name}_${index}.cpp)
     file(CONFIGURE OUTPUT ${unit} CONTENT "${text}" @ONLY)
     list(APPEND units ${unit})
   endif()
