@@ -27,6 +27,7 @@
 
 #include "cellsph/core/atomic_file.hpp"
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/format.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/io/frame_output.hpp"
@@ -161,12 +162,6 @@ void warn_compressibility(const Simulation<Dim, Real>& sim, Progress& progress,
 
 // The share of the fluid per simulated second that the solid guard may put back before the summary warns.
 constexpr double kWallCorrectionWarning = 0.001;
-
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
 
 // ---- Stopping on SIGINT / SIGTERM ------------------------------------------------------------------
 // The handler only records the signal (async-signal-safe); the run loop looks at it between steps,
@@ -475,9 +470,9 @@ template <int Dim, class Real>
 std::string progress_line(const Simulation<Dim, Real>& sim, const RunStart& start, std::uint64_t next_frame,
                           double end_time) {
   const double w = start.wall.seconds();
-  return "t=" + fmt("%.4f", double(sim.time())) + "/" + fmt("%.4g", end_time) + " s  frame " +
-         std::to_string(next_frame) + "  " +
-         fmt("%.0f", double(sim.steps() - start.steps) / std::max(w, 1e-9)) + " steps/s  " +
+  return "t=" + format_number("%.4f", double(sim.time())) + "/" + format_number("%.4g", end_time) +
+         " s  frame " + std::to_string(next_frame) + "  " +
+         format_number("%.0f", double(sim.steps() - start.steps) / std::max(w, 1e-9)) + " steps/s  " +
          std::to_string(sim.fluid_count()) + " fluid particles" + sim.solver_progress() +
          (sim.wall_corrections() > 0 ? "  put back from walls " + std::to_string(sim.wall_corrections())
                                      : "");
@@ -547,7 +542,7 @@ void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start,
   const std::uint64_t steps = sim.steps() - start.steps;
   const double output_ms = outputs.output_ms();
   const double total_ms = tm.neighbors + tm.forces + tm.integration + output_ms;
-  auto pct = [&](double ms) { return fmt("%.0f%%", 100.0 * ms / std::max(total_ms, 1e-9)); };
+  auto pct = [&](double ms) { return format_number("%.0f%%", 100.0 * ms / std::max(total_ms, 1e-9)); };
   std::fprintf(
       stderr,
       "cellsph: done: simulated %.4g s in %s wall, %llu steps (mean dt %.3g s), %llu frames in %s\n"

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cellsph/core/error.hpp"
+#include "cellsph/core/format.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/render/bitmap_font.hpp"
 
@@ -215,12 +216,6 @@ Image downsample(const FrameBuffer& fb, int ss) {
   return img;
 }
 
-std::string format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), fmt, v);
-  return buf;
-}
-
 // 1, 2 or 5 times a power of ten, at most `x`.
 double nice_length(double x) {
   if (!(x > 0) || !std::isfinite(x)) return 0;
@@ -331,10 +326,11 @@ void look_through(ViewAndScale& r, const Camera& cam, const RenderOptions& o, do
   if (!(dot(v.right, v.right) > 0))
     throw InputError("render camera: up vector is zero or parallel to the viewing direction");
   if (!cam.orthographic && !(cam.fov_y_deg > 0 && cam.fov_y_deg < 180))
-    throw InputError("render camera: field of view " + format("%g", cam.fov_y_deg) +
+    throw InputError("render camera: field of view " + format_number("%g", cam.fov_y_deg) +
                      " degrees is outside (0, 180)");
   if (cam.orthographic && cam.ortho_height < 0)
-    throw InputError("render camera: orthographic height " + format("%g", cam.ortho_height) + " is negative");
+    throw InputError("render camera: orthographic height " + format_number("%g", cam.ortho_height) +
+                     " is negative");
   v.up = cross(v.right, v.fwd);
   v.ortho = cam.orthographic;
   const double target_dist = std::sqrt(dot(to_v3(cam.target) - v.eye, to_v3(cam.target) - v.eye));
@@ -424,7 +420,7 @@ void draw_scale_bar(Image& img, const RenderOptions& o, const Layout& layout, do
   img.fill_rect(m, y, m + px, y + 2 * f, kInk);
   img.fill_rect(m, y - 3 * f, m + f, y + 2 * f, kInk);
   img.fill_rect(m + px - f, y - 3 * f, m + px, y + 2 * f, kInk);
-  const std::string label = format("%g", len) + " m" + (at_target ? " at target" : "");
+  const std::string label = format_number("%g", len) + " m" + (at_target ? " at target" : "");
   draw_label(img, m + 2 * f, y - 4 * f - th, label, f, o.background);
 }
 
@@ -450,8 +446,8 @@ void draw_legend(Image& img, const RenderOptions& o, const Layout& layout, const
     const Rgb8 c = colormap(1.0 - static_cast<double>(j) / std::max(1, bar_h - 1));
     img.fill_rect(x, y + j, x + bar_w, y + j + 1, c);
   }
-  draw_text(img, x + bar_w + 4 * f, y, format("%.3g", range.vmax), kInk, f);
-  draw_text(img, x + bar_w + 4 * f, y + bar_h - th, format("%.3g", range.vmin), kInk, f);
+  draw_text(img, x + bar_w + 4 * f, y, format_number("%.3g", range.vmax), kInk, f);
+  draw_text(img, x + bar_w + 4 * f, y + bar_h - th, format_number("%.3g", range.vmin), kInk, f);
 }
 
 void check_render_options(const RenderOptions& o) {
@@ -593,7 +589,7 @@ Image render_image(const Particles<Dim, Real>& p, const RenderOptions& o, const 
 
   // Overlays at final resolution.
   const int f = layout.font, m = layout.margin;
-  if (o.time_label) draw_label(img, m, m, "t = " + format("%.3f", time) + " s", f, o.background);
+  if (o.time_label) draw_label(img, m, m, "t = " + format_number("%.3f", time) + " s", f, o.background);
   if (o.scale_bar && vs.world_per_pixel > 0)
     draw_scale_bar(img, o, layout, vs.world_per_pixel, Dim == 3 && !vs.view.ortho);
   if (o.legend) draw_legend(img, o, layout, range);

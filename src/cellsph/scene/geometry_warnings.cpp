@@ -5,6 +5,7 @@
 // exactly; shaped obstacles (meshes, spheres, cylinders) are not.
 #include <cstdio>
 
+#include "cellsph/core/format.hpp"
 #include "cellsph/scene/scene_readers.hpp"
 
 namespace cellsph::scene_detail {
@@ -14,15 +15,11 @@ namespace {
 constexpr const char* kAxis[3] = {"x", "y", "z"};
 
 std::string metres(double x) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.4g m", x);
-  return buf;
+  return format_number("%.4g m", x);
 }
 
 std::string spacings(double x, double spacing) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.2g", x / spacing);
-  return buf;
+  return format_number("%.2g", x / spacing);
 }
 
 // The gap between two boxes that face each other along exactly one axis (their extents overlap on the

@@ -9,17 +9,12 @@
 #include <cstdio>
 #include <limits>
 
+#include "cellsph/core/format.hpp"
 #include "cellsph/scene/scene_readers.hpp"
 
 namespace cellsph::scene_detail {
 
 namespace {
-
-std::string number_text(const char* format, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, x);
-  return buf;
-}
 
 bool stiffness_given(const nlohmann::json& j) {
   return j.contains(nlohmann::json::json_pointer("/solver/eos/stiffness"));
@@ -96,8 +91,8 @@ std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverC
   const double c = 10 * std::sqrt(2 * g * height);
   cfg.eos.stiffness = cfg.eos.stiffness_for_sound_speed(static_cast<Real>(c), static_cast<Real>(rho0));
   d.value = double(cfg.eos.stiffness);
-  d.why = "speed of sound c = 10 sqrt(2 g H) = " + number_text("%.3g", c) +
-          " m/s, H = " + number_text("%.3g", height) + " m from the fluid's top to the lowest wall";
+  d.why = "speed of sound c = 10 sqrt(2 g H) = " + format_number("%.3g", c) +
+          " m/s, H = " + format_number("%.3g", height) + " m from the fluid's top to the lowest wall";
   return d;
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/core/format.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/particles.hpp"
 
@@ -34,8 +35,8 @@ class CompressibilityWatch {
       const double c = double(cfg.eos.sound_speed(cfg.phases[k].rest_density));
       const std::string who = "phase " + std::to_string(k) + " (" + cfg.phases[k].name + ")";
       const std::string fix = "raise /solver/eos/stiffness (now " +
-                              number("%.4g", double(cfg.eos.stiffness)) + ", speed of sound " +
-                              number("%.3g", c) + " m/s)";
+                              format_number("%.4g", double(cfg.eos.stiffness)) + ", speed of sound " +
+                              format_number("%.3g", c) + " m/s)";
       const double mean = st[k].compression_sum / double(st[k].count);
       if (!mean_ && mean > kWarnMeanCompression) {
         mean_ = true;
@@ -50,8 +51,8 @@ class CompressibilityWatch {
       if (!mach_ && mach > kWarnMach) {
         mach_ = true;
         add(out, t,
-            who + ": Mach number " + number("%.3g", mach) + " (fastest particle " +
-                number("%.3g", std::sqrt(st[k].speed2_max)) + " m/s; over 0.1): " + fix);
+            who + ": Mach number " + format_number("%.3g", mach) + " (fastest particle " +
+                format_number("%.3g", std::sqrt(st[k].speed2_max)) + " m/s; over 0.1): " + fix);
       }
     }
     return out;
@@ -83,15 +84,10 @@ class CompressibilityWatch {
     return st;
   }
 
-  static std::string number(const char* f, double x) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, x);
-    return buf;
-  }
-  static std::string percent(double x) { return number("%.2g", 100 * x) + "%"; }
+  static std::string percent(double x) { return format_number("%.2g", 100 * x) + "%"; }
 
   void add(std::vector<std::string>& out, double t, const std::string& text) {
-    const std::string line = "t = " + number("%.4g", t) + " s: " + text;
+    const std::string line = "t = " + format_number("%.4g", t) + " s: " + text;
     out.push_back(line);
     given_.push_back(line);
   }

@@ -10,18 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "cellsph/core/format.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
 #include "cellsph/solver/models/model_stepper.hpp"
 
 namespace cellsph {
-
-// printf's rendering of one number.
-inline std::string format_number(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 // ", N solves at max_iterations" of the progress line (nothing while there are none).
 inline std::string implicit_hits_progress(const DfsphStats& st) {
