@@ -1,6 +1,6 @@
 # cellsph_unity_sources(OUT NAME BATCH SOURCES...): SOURCES compiled BATCH to a unit (the tests; the
-# library's scene readers and writers), the units named NAME_<k>.cpp. Most of a test unit's
-# compile time is the headers it shares with its neighbours (six solver and scene tests: 66 CPU-s one by
+# library's scene readers and writers; the program's sub-commands), the units named NAME_<k>.cpp. Most of
+# a test unit's compile time is the headers it shares with its neighbours (six solver and scene tests: 66 CPU-s one by
 # one, 29 as one unit), so each generated unit includes BATCH of them, in the glob's (folder) order.
 # CMake's own UNITY_BUILD writes absolute paths into its units, which would make every fresh clone miss
 # the compiler cache; these include paths relative to the checkout (found through -I<checkout>, which
