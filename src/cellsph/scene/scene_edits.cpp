@@ -54,7 +54,7 @@ void check_array_indices(const nlohmann::json& j, const std::string& edit, const
   std::vector<std::string> tokens;
   for (nlohmann::json::json_pointer p(pointer); !p.empty(); p.pop_back()) tokens.push_back(p.back());
   std::reverse(tokens.begin(), tokens.end());  // root first
-  const nlohmann::json* cur = &j;  // nullptr once the path leaves what exists
+  const nlohmann::json* cur = &j;              // nullptr once the path leaves what exists
   std::string path;
   for (const auto& t : tokens) {
     const bool digits =
