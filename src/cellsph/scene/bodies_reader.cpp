@@ -71,7 +71,8 @@ void add_box_body(JsonReader& e, std::size_t k, int layers, const BodyTarget<Dim
   auto bx = e.child("box");
   const auto b = read_box<Dim>(bx);
   bx.finish();
-  const auto n = cells_of<Dim>(b, t.spacing);
+  const auto ax = lattice_of<Dim>(b, t.spacing, LatticeFit::Solid);
+  const long n[3] = {ax[0].n, ax[1].n, ax[2].n};
   double size[3] = {0, 0, 0};
   for (std::size_t a = 0; a < Dim; ++a) {
     if (n[a] < 2)
@@ -89,7 +90,7 @@ void add_box_body(JsonReader& e, std::size_t k, int layers, const BodyTarget<Dim
         Vec<Dim, Real> x;
         for (std::size_t a = 0; a < Dim; ++a) {
           shell = shell || std::min(idx[a], n[a] - 1 - idx[a]) < layers;
-          x[static_cast<int>(a)] = static_cast<Real>(b.lo[a] + (double(idx[a]) + 0.5) * t.spacing);
+          x[static_cast<int>(a)] = static_cast<Real>(ax[a].site(b.lo[a], idx[a]));
         }
         if (shell) add_particle(t.p, x, 0, ParticleKind::Boundary);
       }

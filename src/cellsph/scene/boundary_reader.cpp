@@ -131,18 +131,18 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
     }
     const auto b = read_box<Dim>(e);
     e.finish();
-    const auto n = cells_of<Dim>(b, spacing);
+    const auto ax = lattice_of<Dim>(b, spacing, LatticeFit::Solid);
     for (std::size_t a = 0; a < Dim; ++a)
-      if (n[a] < 1) e.fail("max", "obstacle is thinner than one particle spacing");
-    budget.take(double(n[0]) * double(n[1]) * double(n[2]), ob, std::to_string(k), "this obstacle");
+      if (ax[a].n < 1) e.fail("max", "obstacle is thinner than one particle spacing");
+    budget.take(double(ax[0].n) * double(ax[1].n) * double(ax[2].n), ob, std::to_string(k), "this obstacle");
     // A solid block of static boundary particles.
-    for (long kk = 0; kk < n[2]; ++kk)
-      for (long jj = 0; jj < n[1]; ++jj)
-        for (long ii = 0; ii < n[0]; ++ii) {
+    for (long kk = 0; kk < ax[2].n; ++kk)
+      for (long jj = 0; jj < ax[1].n; ++jj)
+        for (long ii = 0; ii < ax[0].n; ++ii) {
           const long idx[3] = {ii, jj, kk};
           Vec<Dim, Real> x;
           for (std::size_t a = 0; a < Dim; ++a)
-            x[static_cast<int>(a)] = static_cast<Real>(b.lo[a] + (double(idx[a]) + 0.5) * spacing);
+            x[static_cast<int>(a)] = static_cast<Real>(ax[a].site(b.lo[a], idx[a]));
           add_particle(p, x, 0, ParticleKind::Boundary);
         }
     regions.solids.push_back(b);

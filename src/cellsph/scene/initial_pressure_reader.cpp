@@ -29,19 +29,34 @@ double ray_length_in(const Aabb<Dim>& b, const std::array<double, Dim>& x, const
   return std::max(0.0, t1 - t0);
 }
 
-// sum_k W(|k| spacing) over the whole lattice (k integer, self included): the summation density of a
-// lattice site inside the fluid is m times this, which differs from 1 / spacing^Dim by a fraction of a
-// percent (enough for a pressure of the order of rho0 g H at the dam breaks' sound speed).
+// Whether the point x lies strictly inside the box b (a block's lattice sites are half a pitch inside).
+template <int Dim>
+bool strictly_inside(const Aabb<Dim>& b, const std::array<double, Dim>& x) {
+  for (int a = 0; a < Dim; ++a) {
+    const auto k = static_cast<std::size_t>(a);
+    if (!(x[k] > b.lo[k] && x[k] < b.hi[k])) return false;
+  }
+  return true;
+}
+
+// sum_k W(|k pitch|) over the whole lattice of these pitches (k integer, self included): the summation
+// density of a lattice site inside the fluid is m times this, which differs from 1 / spacing^Dim by a
+// fraction of a percent (enough for a pressure of the order of rho0 g H at the dam breaks' sound speed).
 template <int Dim, class Real>
-double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, double spacing) {
-  const int K = static_cast<int>(std::ceil(double(cfg.support) / spacing));
+double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, const std::array<double, 3>& pitch) {
+  double smallest = pitch[0];
+  for (int a = 1; a < Dim; ++a) smallest = std::min(smallest, pitch[static_cast<std::size_t>(a)]);
+  const int K = static_cast<int>(std::ceil(double(cfg.support) / smallest));
   double sum = 0;
   with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
     std::array<int, Dim> k;
     k.fill(-K);
     while (true) {
       double r2 = 0;
-      for (int a = 0; a < Dim; ++a) r2 += double(k[a]) * double(k[a]) * spacing * spacing;
+      for (int a = 0; a < Dim; ++a) {
+        const double d = double(k[a]) * pitch[static_cast<std::size_t>(a)];
+        r2 += d * d;
+      }
       sum += double(w.W2(static_cast<Real>(r2)));
       int a = 0;
       while (a < Dim && ++k[a] > K) k[a++] = -K;
@@ -57,7 +72,9 @@ double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, double spacing) {
 // density for p: m = rho(p) / lattice_kernel_sum. A column then starts in equilibrium instead of
 // falling onto itself while its pressure builds (and without the uniform pressure that the lattice
 // sum's bias gives with m = rho0 spacing^Dim). Blocks do not overlap; walls and obstacles above carry no
-// weight. A phase whose mass the scene sets keeps it.
+// weight. A phase whose mass the scene sets keeps it (times the volume factor of a stretched lattice). A
+// particle of a block whose lattice is stretched (the spacing does not divide it: solver/initial.hpp) takes
+// the kernel sum of that block's lattice.
 // DFSPH has no equation of state (its fluid is incompressible): there every mass is rho0 over the lattice
 // sum, so that the summation density of each lattice site is rho0 exactly, and the solver finds the
 // pressure itself. (The masses compressed by the scene's eos would make a DFSPH column explode in its
@@ -65,12 +82,21 @@ double lattice_kernel_sum(const SolverConfig<Dim, Real>& cfg, double spacing) {
 // of rho0 g depth: with one it takes 6 sweeps instead of 2.)
 template <int Dim, class Real>
 void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& cfg, double spacing,
-                       const std::vector<bool>& mass_given, const std::vector<Aabb<Dim>>& blocks,
-                       const std::vector<std::int32_t>& block_phase, const std::vector<double>& extra) {
+                       const std::vector<bool>& mass_given, const FluidBlocks<Dim>& fluids,
+                       const std::vector<double>& extra) {
+  const auto& blocks = fluids.blocks;
+  const auto& block_phase = fluids.phase;
   double g2 = 0;
   for (int a = 0; a < Dim; ++a) g2 += double(cfg.gravity[a]) * double(cfg.gravity[a]);
   const double g = std::sqrt(g2);
-  const double volume = 1 / lattice_kernel_sum(cfg, spacing);
+  const std::array<double, 3> plain{spacing, spacing, spacing};
+  const double volume = 1 / lattice_kernel_sum(cfg, plain);
+  // Per block: the volume of a particle of its lattice, and its mass over the plain lattice's.
+  std::vector<double> block_volume(blocks.size(), volume), block_factor(blocks.size(), 1);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    for (int a = 0; a < Dim; ++a) block_factor[b] *= fluids.pitch[b][static_cast<std::size_t>(a)] / spacing;
+    if (block_factor[b] != 1) block_volume[b] = 1 / lattice_kernel_sum(cfg, fluids.pitch[b]);
+  }
   std::array<double, Dim> up{};
   for (int a = 0; a < Dim; ++a) up[static_cast<std::size_t>(a)] = g > 0 ? -double(cfg.gravity[a]) / g : 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -78,6 +104,13 @@ void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& c
     std::array<double, Dim> x{};
     for (int a = 0; a < Dim; ++a) x[static_cast<std::size_t>(a)] = double(p.x[i][a]);
     double pressure = extra[i];
+    double own_volume = volume, own_factor = 1;
+    for (std::size_t b = 0; b < blocks.size(); ++b)
+      if (strictly_inside<Dim>(blocks[b], x)) {
+        own_volume = block_volume[b];
+        own_factor = block_factor[b];
+        break;
+      }
     if (g > 0)
       for (std::size_t b = 0; b < blocks.size(); ++b)
         pressure += g * double(cfg.phases[static_cast<std::size_t>(block_phase[b])].rest_density) *
@@ -87,8 +120,8 @@ void start_hydrostatic(Particles<Dim, Real>& p, const SolverConfig<Dim, Real>& c
     const bool incompressible = implicit_pressure(cfg.model);
     const double rho =
         incompressible ? double(rho0) : double(cfg.eos.density(static_cast<Real>(pressure), rho0));
-    p.m[i] = mass_given[ph] ? static_cast<Real>(double(cfg.phases[ph].mass) * rho / double(rho0))
-                            : static_cast<Real>(rho * volume);
+    p.m[i] = mass_given[ph] ? static_cast<Real>(double(cfg.phases[ph].mass) * own_factor * rho / double(rho0))
+                            : static_cast<Real>(rho * own_volume);
     // The continuity density starts from it (summation density recomputes it from the masses).
     if (p.rho.size() == p.size()) p.rho[i] = static_cast<Real>(rho);
   }
@@ -147,7 +180,7 @@ void read_initial_pressure(JsonReader& r, double spacing, const SolverConfig<Dim
                            const PhaseTable& phases, const FluidBlocks<Dim>& fluids,
                            Particles<Dim, Real>& p) {
   if (r.choice("initial_pressure", "zero", {"zero", "hydrostatic"}) == "hydrostatic")
-    start_hydrostatic(p, cfg, spacing, phases.mass_given, fluids.blocks, fluids.phase,
+    start_hydrostatic(p, cfg, spacing, phases.mass_given, fluids,
                       shaped_fluid_pressure(r, spacing, cfg, fluids, p));
 }
 

@@ -24,6 +24,7 @@ PhaseTable read_phases(JsonReader& r, double spacing, SolverConfig<Dim, Real>& c
     cfg.phases[0].mass = cfg.phases[0].rest_density * static_cast<Real>(std::pow(spacing, Dim));
     t.names.push_back(cfg.phases[0].name);
     t.mass_given.push_back(false);
+    t.mass.push_back(double(cfg.phases[0].mass));
     return t;
   }
   cfg.phases.clear();
@@ -44,6 +45,7 @@ PhaseTable read_phases(JsonReader& r, double spacing, SolverConfig<Dim, Real>& c
     t.mass_given.push_back(ph.mass != 0);
     if (ph.mass == 0) ph.mass = ph.rest_density * static_cast<Real>(std::pow(spacing, Dim));
     t.names.push_back(ph.name);
+    t.mass.push_back(double(ph.mass));
     cfg.phases.push_back(ph);
   }
   return t;

@@ -18,6 +18,7 @@
 #include "cellsph/scene/json_reader.hpp"
 #include "cellsph/scene/particle_budget.hpp"
 #include "cellsph/scene/scene.hpp"
+#include "cellsph/solver/initial.hpp"
 
 namespace cellsph::scene_detail {
 
@@ -64,12 +65,10 @@ bool inside(const Aabb<Dim>& inner, const Aabb<Dim>& outer, double tol) {
   return true;
 }
 
-// Number of lattice cells of `spacing` along each axis of a block.
+// The lattice of `spacing` in a block along each axis (solver/initial.hpp).
 template <int Dim>
-std::array<long, 3> cells_of(const Aabb<Dim>& b, double spacing) {
-  std::array<long, 3> n{1, 1, 1};
-  for (std::size_t a = 0; a < Dim; ++a) n[a] = std::lround((b.hi[a] - b.lo[a]) / spacing);
-  return n;
+std::array<LatticeAxis, 3> lattice_of(const Aabb<Dim>& b, double spacing, LatticeFit fit) {
+  return cellsph::lattice_of<Dim>(b.lo.data(), b.hi.data(), spacing, fit);
 }
 
 // Where a scene's mesh files and motion tables are: beside the scene file, or compiled in for a
@@ -85,6 +84,7 @@ MeshFiles mesh_files_of(const std::string& source);
 struct PhaseTable {
   std::vector<std::string> names;
   std::vector<bool> mass_given;  // phases[k].mass set by the scene
+  std::vector<double> mass;      // phases[k].mass: the scene's, or rho0 spacing^Dim
 
   // The "phase" key of a fluid block: an index or a name of a phase; 0 when absent.
   std::int32_t read_reference(JsonReader& e) const;
@@ -110,6 +110,9 @@ template <int Dim>
 struct FluidBlocks {
   std::vector<Aabb<Dim>> blocks;
   std::vector<std::int32_t> phase;  // of each block
+  // The pitch of each block's lattice along each axis: the spacing, or stretched where the spacing does not
+  // divide the block (solver/initial.hpp, fluid_lattice_axis).
+  std::vector<std::array<double, 3>> pitch;
   // Shaped fluid volumes: their bounds (for the overlap checks), and the particles each made.
   std::vector<Aabb<Dim>> shape_bounds;
   std::vector<std::pair<std::size_t, std::size_t>> shape_ranges;
