@@ -82,17 +82,19 @@ __global__ void __launch_bounds__(kBlock)
     values[k] = static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
 }
 
-// partial[b] = values[b kSumBlock] + ... in index order, one thread per block of kSumBlock: the CPU's
-// order (pass_driver.hpp reduce_sum_n), so the sum has the CPU's bits. A template (T = double) so that the
-// header can be included by several .cu files without defining the kernel twice.
-template <class T>
+// partial[b] = the exact sum of values[b kSumBlock, (b + 1) kSumBlock) (core/exact_sum.hpp), one thread per
+// block of kSumBlock, as the CPU's reduce_sum_n accumulates it: merged on the host, the sum has the CPU's
+// bits. A template (Acc = ExactSum) so that the header can be included by several .cu files without
+// defining the kernel twice.
+template <class Acc>
 __global__ void __launch_bounds__(kBlock)
-    block_sum_kernel(const T* values, std::size_t n, T* partial, std::size_t blocks) {
+    block_sum_kernel(const double* values, std::size_t n, Acc* partial, std::size_t blocks) {
   const std::size_t b = std::size_t{blockIdx.x} * blockDim.x + threadIdx.x;
   if (b >= blocks) return;
   const std::size_t begin = b * kSumBlock, end = begin + kSumBlock < n ? begin + kSumBlock : n;
-  T s = 0;
-  for (std::size_t k = begin; k < end; ++k) s += values[k];
+  Acc s;
+  for (std::size_t k = begin; k < end; ++k) s.add(values[k]);
+  s.normalize();
   partial[b] = s;
 }
 
@@ -148,15 +150,13 @@ double reduce_sum(const DeviceIndexSet<CudaSpace>& set, const Pass& pass) {
                                                                                         pass, values.data());
   cuda_detail::check_launch("value_kernel<<<>>>");
   const std::size_t blocks = (set.size + kSumBlock - 1) / kSumBlock;
-  DeviceArray<double, CudaSpace> partial(blocks);
-  cuda_detail::block_sum_kernel<double><<<cuda_detail::blocks_for(blocks), cuda_detail::kBlock>>>(
+  DeviceArray<ExactSum, CudaSpace> partial(blocks);
+  cuda_detail::block_sum_kernel<ExactSum><<<cuda_detail::blocks_for(blocks), cuda_detail::kBlock>>>(
       values.data(), set.size, partial.data(), blocks);
   cuda_detail::check_launch("block_sum_kernel<<<>>>");
-  std::vector<double> host(blocks);
+  std::vector<ExactSum> host(blocks);
   partial.download(host.data());
-  double s = 0;
-  for (const double q : host) s += q;
-  return s;
+  return merged_value(host);
 }
 
 // Deterministic: the minimum failing index.

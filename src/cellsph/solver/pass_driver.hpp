@@ -13,6 +13,7 @@
 #include <limits>
 #include <vector>
 
+#include "cellsph/core/exact_sum.hpp"
 #include "cellsph/core/parallel.hpp"
 
 namespace cellsph {
@@ -52,30 +53,35 @@ Result reduce_max_n(const std::uint32_t* idx, std::size_t n, Result init, const 
   return r;
 }
 
-// The sum of pass(idx[k]) for k < n, in double, independent of the thread count: the entries are cut into
-// fixed blocks of kSumBlock, each summed in order, and the block sums are added in order (a plain
-// per-thread partial sum would change in the last bits with the thread count). The CUDA driver
-// (cuda/cuda_driver.cuh) adds in the same order, so a device gives the same bits.
+// The sum of pass(idx[k]) for k < n, exactly, rounded once (core/exact_sum.hpp): the same bits whatever
+// the thread count, the order, the split of the entries between threads, a device's blocks or MPI ranks.
+// The entries are cut into blocks of kSumBlock for the threads (and the device's block sums), each block
+// into its own accumulator, merged at the end. The CUDA driver (cuda/cuda_driver.cuh) accumulates the same
+// way, so a device gives the same bits.
 inline constexpr std::size_t kSumBlock = 1024;
 
-// The sum of block b's entries (reduce_sum_n's unit), in order.
+// Block b's entries (reduce_sum_n's unit) into `acc`.
 template <class Pass>
-double reduce_sum_block(const std::uint32_t* idx, std::size_t n, std::size_t b, const Pass& pass) {
-  double s = 0;
+void reduce_sum_block(const std::uint32_t* idx, std::size_t n, std::size_t b, const Pass& pass,
+                      ExactSum& acc) {
   const std::size_t end = std::min(n, (b + 1) * kSumBlock);
   for (std::size_t k = b * kSumBlock; k < end; ++k)
-    s += static_cast<double>(pass(static_cast<std::size_t>(idx[k])));
-  return s;
+    acc.add(static_cast<double>(pass(static_cast<std::size_t>(idx[k]))));
+}
+
+// The merged value of per-block accumulators.
+inline double merged_value(const std::vector<ExactSum>& partial) {
+  ExactSum s;
+  for (const ExactSum& q : partial) s.merge(q);
+  return s.value();
 }
 
 template <class Pass>
 double reduce_sum_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
   const std::size_t blocks = (n + kSumBlock - 1) / kSumBlock;
-  std::vector<double> partial(blocks, 0.0);
-  parallel_for(blocks, [&](std::size_t b) { partial[b] = reduce_sum_block(idx, n, b, pass); });
-  double s = 0;
-  for (const double q : partial) s += q;
-  return s;
+  std::vector<ExactSum> partial(blocks);
+  parallel_for(blocks, [&](std::size_t b) { reduce_sum_block(idx, n, b, pass, partial[b]); });
+  return merged_value(partial);
 }
 
 // The number of indices of a set (a device set, device_driver.hpp, has its own overload).
@@ -191,19 +197,17 @@ void run_pass(const BalancedIndexSet& set, const Pass& pass) {
   });
 }
 
-// reduce_sum_n's blocks and order, each part summing its blocks (block_cuts).
+// reduce_sum_n's blocks, each part summing its blocks (block_cuts): the exact sum, as for the plain set.
 template <class Pass>
 double reduce_sum(const BalancedIndexSet& set, const Pass& pass) {
   const std::uint32_t* idx = set.set->data();
   const std::size_t n = set.set->size();
-  std::vector<double> partial((n + kSumBlock - 1) / kSumBlock, 0.0);
+  std::vector<ExactSum> partial((n + kSumBlock - 1) / kSumBlock);
   for_each_part(set, [&](std::size_t t) {
     for (std::size_t b = set.block_cuts[t]; b < set.block_cuts[t + 1]; ++b)
-      partial[b] = reduce_sum_block(idx, n, b, pass);
+      reduce_sum_block(idx, n, b, pass, partial[b]);
   });
-  double s = 0;
-  for (const double q : partial) s += q;
-  return s;
+  return merged_value(partial);
 }
 
 inline std::size_t set_size(const BalancedIndexSet& set) {

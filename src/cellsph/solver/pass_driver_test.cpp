@@ -109,34 +109,30 @@ struct Line {
   }
 };
 
-// The documented order (blocks of kSumBlock summed in order, then the block sums in order), written out as a
-// plain loop; the same bits for every thread count, and the exact sum within rounding.
-TEST(PassDriver, ReduceSumAddsInFixedBlocksWhateverTheThreadCount) {
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-1, 1);
+// The exact sum rounded once, for every thread count: values m 2^e (m < 2^53, e in [-60, 0]) whose exact sum
+// a 128-bit integer in units of 2^-60 holds, converted to double by the compiler's correctly rounded
+// conversion (the reference, apart from core/exact_sum.hpp).
+TEST(PassDriver, ReduceSumIsTheExactSumRoundedOnceWhateverTheThreadCount) {
+  __extension__ typedef __int128 Int128;
+  std::mt19937_64 rng(11);
   std::vector<double> value(5000);
-  for (double& v : value) v = u(rng) * std::pow(10.0, static_cast<int>(rng() % 9) - 4);
-  const IndexSet set = random_set(rng, 5000);  // about 3300 entries: four blocks, the last partial
+  std::vector<Int128> units(5000);
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const auto m = static_cast<std::int64_t>(rng() >> 11);
+    const int e = static_cast<int>(rng() % 61) - 60;
+    const bool negative = (rng() & 1) != 0;
+    value[i] = std::ldexp(static_cast<double>(m), e) * (negative ? -1 : 1);
+    units[i] = (static_cast<Int128>(m) << (e + 60)) * (negative ? -1 : 1);
+  }
+  std::mt19937 rng32(11);
+  const IndexSet set = random_set(rng32, 5000);  // about 3300 entries: four blocks, the last partial
   auto pass = [&](std::size_t i) { return value[i]; };
-  double want = 0;
-  long double exact = 0, magnitude = 0;
-  for (std::size_t b = 0; b * kSumBlock < set.size(); ++b) {
-    double block = 0;
-    for (std::size_t k = b * kSumBlock; k < std::min(set.size(), (b + 1) * kSumBlock); ++k)
-      block += value[set[k]];
-    want += block;
-  }
-  for (const std::uint32_t i : set) {
-    exact += value[i];
-    magnitude += std::abs(value[i]);
-  }
-  // Recursive summation's bound: (n - 1) eps sum |v|.
-  const double bound = static_cast<double>(set.size()) * 1.2e-16 * static_cast<double>(magnitude);
+  Int128 total = 0;
+  for (const std::uint32_t i : set) total += units[i];
+  const double want = std::ldexp(static_cast<double>(total), -60);
   for (const int threads : {1, 2, 3}) {
     ScopedThreads st(threads);
-    const double got = reduce_sum(set, pass);
-    EXPECT_EQ(got, want) << threads << " threads";
-    EXPECT_NEAR(got, static_cast<double>(exact), bound);
+    EXPECT_EQ(reduce_sum(set, pass), want) << threads << " threads";
   }
   EXPECT_EQ(reduce_sum(IndexSet{}, pass), 0.0);
 }
