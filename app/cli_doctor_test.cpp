@@ -14,7 +14,7 @@ TEST(CliDoctor, ReportsBackendsThreadsCpuAndLibraries) {
   // "build for any x86-64 CPU" or "build for this machine's CPU" (CELLSPH_NATIVE).
   for (const char* line :
        {"build for ", "backends:     cpu (OpenMP)", "device:", "threads:", "cpu:          AVX2 ",
-        "compiler:", "nlohmann-json 3.", "nanoflann 1.", "OpenVDB ", "libpng 1."})
+        "mpi:          ", "compiler:", "nlohmann-json 3.", "nanoflann 1.", "OpenVDB ", "libpng 1."})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " in:\n" << r.out;
 }
 

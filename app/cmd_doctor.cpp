@@ -10,6 +10,7 @@
 #include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cellsph/distributed/communicator.hpp"
 #include "cellsph/neighbors/cell_index_simd.hpp"
 #include "cellsph/render/image.hpp"
 #include "cellsph/solver/backend.hpp"
@@ -25,6 +26,7 @@ std::string nanoflann_version() {
 }
 
 int doctor() {
+  if (distributed::world().rank() != 0) return 0;  // under mpirun: one report, rank 0's
   std::printf("cellsph 0.1.0, %s build%s\n",
 #ifdef NDEBUG
               "optimised",
@@ -51,6 +53,15 @@ int doctor() {
       "cpu:          AVX2 %s; Cell Indexing's inner loops run %s (8 candidates at a time with avx2, 4 with "
       "sse2; CELLSPH_SIMD=sse2 or scalar chooses a narrower one)\n",
       best_simd_path() == SimdPath::Avx2 ? "yes" : "no", simd_path_name(simd_path()));
+  const auto world = distributed::world();
+  if (!distributed::built_with_mpi())
+    std::printf("mpi:          not in this build (Debian's libopenmpi-dev and -DCELLSPH_MPI=ON)\n");
+  else if (distributed::launched_by_mpi_launcher())
+    std::printf("mpi:          %s; %d ranks (this is rank %d)\n", distributed::mpi_library_version().c_str(),
+                world.size(), world.rank());
+  else
+    std::printf("mpi:          %s; 1 process (not started by mpirun)\n",
+                distributed::mpi_library_version().c_str());
   std::printf("compiler:     %s, C++ %ld, OpenMP %d\n",
 #if defined(__clang__)
               "clang " __clang_version__,

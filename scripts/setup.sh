@@ -6,6 +6,7 @@ PKGS=(g++ cmake ninja-build git pkg-config
       libgtest-dev libgmock-dev libbenchmark-dev
       libopenvdb-dev libboost-dev libboost-iostreams-dev libassimp-dev
       python3-dev pybind11-dev python3-numpy
+      libopenmpi-dev openmpi-bin
       ccache)
 # With --test: what the tests use to check outputs with other people's tools (ffmpeg for the MP4,
 # VTK's own .vtu reader through Debian's python3-vtk9), the Python module's tests (SciPy's cKDTree as

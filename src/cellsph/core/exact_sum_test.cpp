@@ -77,6 +77,9 @@ TEST(ExactSum, MatchesAnIndependentIntegerSumInAnyOrderAndSplit) {
     const double reference = std::ldexp(static_cast<double>(total), -40);
     const double forward = exact_sum_of(xs);
     ASSERT_EQ(bits(forward), bits(reference)) << "trial " << trial;
+    ExactSum terms;  // the loop of the pass driver's blocks
+    terms.add_terms(0, n, [&](std::size_t i) { return xs[i]; });
+    ASSERT_EQ(bits(terms.value()), bits(reference)) << "trial " << trial;
     // Shuffled and cut into parts summed apart, then merged in a random order: the same bits.
     std::shuffle(xs.begin(), xs.end(), rng);
     const std::size_t parts = 1 + rng() % 7;

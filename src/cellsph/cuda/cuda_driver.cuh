@@ -93,7 +93,7 @@ __global__ void __launch_bounds__(kBlock)
   if (b >= blocks) return;
   const std::size_t begin = b * kSumBlock, end = begin + kSumBlock < n ? begin + kSumBlock : n;
   Acc s;
-  for (std::size_t k = begin; k < end; ++k) s.add(values[k]);
+  s.add_terms(begin, end, [values](std::size_t k) { return values[k]; });
   s.normalize();
   partial[b] = s;
 }

@@ -64,9 +64,13 @@ inline constexpr std::size_t kSumBlock = 1024;
 template <class Pass>
 void reduce_sum_block(const std::uint32_t* idx, std::size_t n, std::size_t b, const Pass& pass,
                       ExactSum& acc) {
-  const std::size_t end = std::min(n, (b + 1) * kSumBlock);
-  for (std::size_t k = b * kSumBlock; k < end; ++k)
-    acc.add(static_cast<double>(pass(static_cast<std::size_t>(idx[k]))));
+  // The pass's values first, then their sum: in one loop the accumulator's registers pushed the pass's
+  // locals onto the stack (DFSPH's source pass 25% slower, measured).
+  double values[kSumBlock];
+  const std::size_t begin = b * kSumBlock, count = std::min(n, begin + kSumBlock) - begin;
+  for (std::size_t k = 0; k < count; ++k)
+    values[k] = static_cast<double>(pass(static_cast<std::size_t>(idx[begin + k])));
+  acc.add_terms(0, count, [&values](std::size_t k) { return values[k]; });
 }
 
 // The merged value of per-block accumulators.
