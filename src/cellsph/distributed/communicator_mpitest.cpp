@@ -10,6 +10,7 @@
 
 #include "cellsph/core/exact_sum.hpp"
 #include "cellsph/distributed/communicator.hpp"
+#include "cellsph/distributed/curve_split.hpp"
 
 namespace cellsph::distributed {
 namespace {
@@ -65,6 +66,32 @@ TEST(Communicator, ExactSumOverRanksHasTheSingleProcessBits) {
   double plain = 0;
   for (const double t : terms) plain += t;
   EXPECT_NE(bits_of(plain), bits_of(want));
+}
+
+// The same particles dealt to the ranks in two ways: the cuts are those one process finds over all of them,
+// on every rank (they depend on the keys and weights only, not on who holds them).
+TEST(CurveSplitOverRanks, CutsDoNotDependOnWhichRankHoldsWhichParticle) {
+  const auto w = world();
+  std::mt19937_64 rng(77);
+  std::vector<std::uint64_t> keys(30000);
+  std::vector<std::int64_t> weight(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    keys[i] = i % 3 == 0 ? rng() >> 24 : (std::uint64_t{1} << 20) + (rng() >> 48);  // 40-bit keys, skewed
+    weight[i] = 1 + static_cast<std::int64_t>(rng() % 40);
+  }
+  const auto one = split_curve(keys, weight, 40, 5, 0.001, [](std::int64_t*, int) {});
+  for (int way = 0; way < 2; ++way) {
+    std::vector<std::uint64_t> mine;
+    std::vector<std::int64_t> mine_w;
+    for (std::size_t i = 0; i < keys.size(); ++i)
+      if (int(way == 0 ? i * std::size_t(w.size()) / keys.size() : i % std::size_t(w.size())) == w.rank()) {
+        mine.push_back(keys[i]);
+        mine_w.push_back(weight[i]);
+      }
+    const auto split =
+        split_curve(mine, mine_w, 40, 5, 0.001, [&w](std::int64_t* v, int n) { w.sum_in_place(v, n); });
+    EXPECT_EQ(split.start, one.start) << "way " << way << ", rank " << w.rank();
+  }
 }
 
 }  // namespace

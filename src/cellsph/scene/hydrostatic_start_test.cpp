@@ -16,7 +16,7 @@
 namespace cellsph {
 namespace {
 
-constexpr double kG = 9.81;
+constexpr double kStartGravity = 9.81;
 constexpr double kStiffness = 1e5;  // ratio EOS: rho = rho0 (1 + p / k), a 10% compression at 1 m of water
 
 // Heavy water (rho0 1000) in [0,1] x [0,1] under light oil (rho0 800) in [0,1] x [1,1.5], spacing 0.05.
@@ -35,7 +35,7 @@ nlohmann::json stacked(const std::string& start) {
 
 // The analytic pressure under the stacked layers: the depth below each block's top, inside that block.
 double stacked_pressure(double y, bool water) {
-  return water ? kG * (800 * 0.5 + 1000 * (1 - y)) : kG * 800 * (1.5 - y);
+  return water ? kStartGravity * (800 * 0.5 + 1000 * (1 - y)) : kStartGravity * 800 * (1.5 - y);
 }
 
 // What the start promises: at every lattice site farther than one support from the edges of its block,
@@ -61,7 +61,7 @@ TEST(HydrostaticStart, SummationDensityIsTheHydrostaticDensity) {
                w.W2(distance2(p.x[i], p.x[j]));
       const double rho0 = water ? 1000 : 800;
       const double expect = rho0 * (1 + stacked_pressure(y, water) / kStiffness);
-      worst = std::max(worst, std::abs(rho - expect) / (1000 * kG * 1.5 / kStiffness * 1000));
+      worst = std::max(worst, std::abs(rho - expect) / (1000 * kStartGravity * 1.5 / kStiffness * 1000));
       ++checked;
     }
     EXPECT_GT(checked, 150U);
@@ -91,11 +91,11 @@ TEST(HydrostaticStart, GivenPhaseMassIsScaledByTheCompression) {
 // and masses scale with 1 + rho0 g x / k.
 TEST(HydrostaticStart, DepthIsMeasuredAgainstGravity) {
   auto j = stacked("hydrostatic");
-  j["solver"]["gravity"] = {kG, 0};
+  j["solver"]["gravity"] = {kStartGravity, 0};
   j["fluids"] = nlohmann::json::parse(R"([{"min": [0, 0], "max": [1, 0.5]}])");
   const auto s = load_scene<2, double>(j, "sideways.json");
   const auto& p = s.particles;
-  auto compression = [&](std::size_t i) { return 1 + 1000 * kG * p.x[i][0] / kStiffness; };
+  auto compression = [&](std::size_t i) { return 1 + 1000 * kStartGravity * p.x[i][0] / kStiffness; };
   for (std::size_t i = 1; i < p.size(); ++i)
     EXPECT_NEAR(p.m[i] / p.m[0], compression(i) / compression(0), 1e-12) << "particle " << i;
 }
@@ -134,7 +134,7 @@ TankRun run_tank(const std::string& start) {
   auto scene = load_scene<2, double>(j, "tank.json");
   Simulation<2, double> sim(scene.solver, scene.particles);
   sim.step();
-  const double H = 0.5, h = 0.05, scale = 1000 * kG * H;
+  const double H = 0.5, h = 0.05, scale = 1000 * kStartGravity * H;
   TankRun out{0, 0};
   const auto& p = sim.particles();
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -142,7 +142,7 @@ TankRun run_tank(const std::string& start) {
     const double x = p.x[i][0], y = p.x[i][1];
     if (x < h || x > H - h || y < h || y > H - h) continue;  // the walls' and the surface's reach
     out.worst_pressure_error =
-        std::max(out.worst_pressure_error, std::abs(p.p[i] - 1000 * kG * (H - y)) / scale);
+        std::max(out.worst_pressure_error, std::abs(p.p[i] - 1000 * kStartGravity * (H - y)) / scale);
   }
   for (int s = 1; s < 300; ++s) sim.step();
   for (std::size_t i = 0; i < p.size(); ++i)

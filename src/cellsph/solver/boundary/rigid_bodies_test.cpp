@@ -325,7 +325,7 @@ TEST(RigidBodies, MomentumConservedWithoutGravityIn3D) {
   EXPECT_LT(b.q[0], 0.9999);
 }
 
-std::string load_error(const json& j) {
+std::string body_load_error(const json& j) {
   try {
     auto s = load(j);
     Simulation<2, double> sim(s.solver, std::move(s.particles));
@@ -336,23 +336,23 @@ std::string load_error(const json& j) {
 }
 
 TEST(RigidBodies, BadInputNamesKeyAndValue) {
-  EXPECT_NE(load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, 0))).find("/bodies/0/density"), std::string::npos);
-  EXPECT_NE(load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, -3))).find("-3"), std::string::npos);
-  EXPECT_NE(load_error(tank(box_body(0.4, 0.5, 0.41, 0.6, 500))).find("thinner than two"), std::string::npos);
-  EXPECT_NE(load_error(tank(box_body(0.4, 0.5, 0.3, 0.6, 500))).find("/bodies/0/box/max"), std::string::npos);
-  EXPECT_NE(load_error(tank(json{{"density", 500}})).find("give a shape"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, 0))).find("/bodies/0/density"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, -3))).find("-3"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.41, 0.6, 500))).find("thinner than two"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.3, 0.6, 500))).find("/bodies/0/box/max"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(json{{"density", 500}})).find("give a shape"), std::string::npos);
   json sphere = json{{"sphere", {{"center", {0.5, 0.6}}, {"radius", 0}}}, {"density", 500}};
-  EXPECT_NE(load_error(tank(sphere)).find("radius"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(sphere)).find("radius"), std::string::npos);
   json typo = box_body(0.4, 0.5, 0.6, 0.6, 500);
   typo["densty"] = 3;
-  EXPECT_NE(load_error(tank(typo)).find("densty"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(typo)).find("densty"), std::string::npos);
   json paper = tank(box_body(0.4, 0.5, 0.6, 0.6, 500));
   paper["solver"]["model"] = "paper";
   paper["solver"].erase("density");
   paper["solver"].erase("density_diffusion");
   paper["solver"].erase("artificial_viscosity");
-  EXPECT_NE(load_error(paper).find("floating bodies need the WCSPH model"), std::string::npos)
-      << load_error(paper);
+  EXPECT_NE(body_load_error(paper).find("floating bodies need the WCSPH model"), std::string::npos)
+      << body_load_error(paper);
   // A device builds the body particles' rows out to h only: a contact distance of h or more is refused.
   auto s = load(tank(box_body(0.4, 0.5, 0.6, 0.6, 500)));
   s.solver.backend = Backend::HostDevice;
