@@ -33,6 +33,7 @@
 
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/scene/builtin_scenes_test_util.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"
 
@@ -198,18 +199,8 @@ TEST_P(SceneStart, AtCoarserSpacingsFluidStartsApartAndNeverFasterThanAFall) {
   }
 }
 
-std::vector<std::string> start_scene_names() {
-  std::vector<std::string> v;
-  for (const auto& s : builtin_scenes()) v.emplace_back(s.name);
-  return v;
-}
-
-INSTANTIATE_TEST_SUITE_P(Builtin, SceneStart, ::testing::ValuesIn(start_scene_names()),
-                         [](const auto& param_info) {
-                           std::string n = param_info.param;
-                           std::replace(n.begin(), n.end(), '-', '_');
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Builtin, SceneStart, ::testing::ValuesIn(test::builtin_scene_names()),
+                         test::scene_test_name);
 
 }  // namespace
 }  // namespace cellsph

@@ -27,6 +27,7 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/scene/builtin_scenes.hpp"
+#include "cellsph/scene/builtin_scenes_test_util.hpp"
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"
 
@@ -258,18 +259,8 @@ TEST_P(SceneStability, CoarsenedStaysFiniteInsideAndEnergyBounded) {
     run_scene<3, double>(j, GetParam(), !moving);
 }
 
-std::vector<std::string> scene_names() {
-  std::vector<std::string> v;
-  for (const auto& s : builtin_scenes()) v.emplace_back(s.name);
-  return v;
-}
-
-INSTANTIATE_TEST_SUITE_P(Builtin, SceneStability, ::testing::ValuesIn(scene_names()),
-                         [](const auto& param_info) {
-                           std::string n = param_info.param;
-                           std::replace(n.begin(), n.end(), '-', '_');
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Builtin, SceneStability, ::testing::ValuesIn(test::builtin_scene_names()),
+                         test::scene_test_name);
 
 }  // namespace
 }  // namespace cellsph
