@@ -10,9 +10,11 @@
 
 namespace cellsph::distributed {
 
+#if defined(CELLSPH_HAVE_MPI)
 namespace {
 bool g_active = false;  // an MpiSession initialised MPI in this process
 }  // namespace
+#endif
 
 bool built_with_mpi() {
 #if defined(CELLSPH_HAVE_MPI)
