@@ -336,10 +336,13 @@ std::string body_load_error(const json& j) {
 }
 
 TEST(RigidBodies, BadInputNamesKeyAndValue) {
-  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, 0))).find("/bodies/0/density"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, 0))).find("/bodies/0/density"),
+            std::string::npos);
   EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.6, 0.6, -3))).find("-3"), std::string::npos);
-  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.41, 0.6, 500))).find("thinner than two"), std::string::npos);
-  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.3, 0.6, 500))).find("/bodies/0/box/max"), std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.41, 0.6, 500))).find("thinner than two"),
+            std::string::npos);
+  EXPECT_NE(body_load_error(tank(box_body(0.4, 0.5, 0.3, 0.6, 500))).find("/bodies/0/box/max"),
+            std::string::npos);
   EXPECT_NE(body_load_error(tank(json{{"density", 500}})).find("give a shape"), std::string::npos);
   json sphere = json{{"sphere", {{"center", {0.5, 0.6}}, {"radius", 0}}}, {"density", 500}};
   EXPECT_NE(body_load_error(tank(sphere)).find("radius"), std::string::npos);
