@@ -411,4 +411,23 @@ std::vector<P3> sample(const Shape& s, double spacing, bool outside, double dept
   return all;
 }
 
+std::vector<double> signed_distance_grid(const Shape& s, const P3& origin, double pitch,
+                                         const std::array<long, 3>& n, double band) {
+  const std::size_t rows = static_cast<std::size_t>(n[1] * n[2]), row = static_cast<std::size_t>(n[0]);
+  std::vector<double> out(rows * row, band);
+  parallel_chunks(rows, 16, [&](std::size_t r0, std::size_t r1) {
+    for (std::size_t r = r0; r < r1; ++r) {
+      const long j = static_cast<long>(r) % n[1], k = static_cast<long>(r) / n[1];
+      for (std::size_t i = 0; i < row; ++i) {
+        const P3 p{origin[0] + double(i) * pitch, origin[1] + double(j) * pitch,
+                   s.dim() == 3 ? origin[2] + double(k) * pitch : 0.0};
+        const Side side = s.classify(p, band);
+        const double d = std::min(side.distance, band);
+        out[r * row + i] = side.sign < 0 ? -d : d;
+      }
+    }
+  });
+  return out;
+}
+
 }  // namespace cellsph::geometry

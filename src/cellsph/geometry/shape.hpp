@@ -61,6 +61,8 @@ class Shape {
   std::shared_ptr<const MeshDistance> mesh_;
   P3 lo_{}, hi_{};
   friend std::vector<P3> sample(const Shape&, double, bool, double);
+  friend std::vector<double> signed_distance_grid(const Shape&, const P3&, double, const std::array<long, 3>&,
+                                                  double);
 };
 
 // The sites of the global lattice ((i + 1/2) spacing on every axis; z = 0 in 2D) on one side of the
@@ -68,6 +70,12 @@ class Shape {
 // 0 < d <= depth (depth = infinity: the whole inside). Sites are in lattice order (x fastest), which
 // does not depend on the thread count.
 std::vector<P3> sample(const Shape& s, double spacing, bool outside, double depth);
+
+// The shape's signed distance (negative inside) at the nodes origin + pitch (i, j, k), i < n[0], j < n[1],
+// k < n[2] (n[2] = 1 in 2D), x fastest, clamped to [-band, band]: exact within the band. The nodes' rows
+// are computed in parallel, each on its own, so the values do not depend on the thread count.
+std::vector<double> signed_distance_grid(const Shape& s, const P3& origin, double pitch,
+                                         const std::array<long, 3>& n, double band);
 
 // How many lattice sites sample() looks at (its bounding box of sites), to count before sampling.
 double lattice_sites(const Shape& s, double spacing, double margin);

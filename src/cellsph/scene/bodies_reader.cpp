@@ -27,7 +27,7 @@ void read_body_contact(JsonReader& r, double spacing, RigidBodies& rb) {
 }
 
 // What every body adds to: the particles, the budget that counts them (its errors name the body in
-// /bodies, `list`), and the shapes the fluid keeps clear of.
+// /bodies, `list`), the shapes the fluid keeps clear of, and the solid guard.
 template <int Dim, class Real>
 struct BodyTarget {
   JsonReader& list;
@@ -36,6 +36,7 @@ struct BodyTarget {
   ParticleBudget& budget;
   Particles<Dim, Real>& p;
   Regions<Dim>& regions;
+  SolidGuard<Dim, Real>& guard;
 };
 
 // The shape the fluid keeps half a spacing from a box body, as from a shape: in 2D the box is a
@@ -96,6 +97,8 @@ void add_box_body(JsonReader& e, std::size_t k, int layers, const BodyTarget<Dim
       }
   box_mass_properties(Dim, body.density, size, body);
   body.shape = "box";
+  t.guard.boxes.push_back(
+      {to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), GuardMover{-1, static_cast<std::int32_t>(k)}});
   t.regions.solid_shapes.push_back(box_body_shape<Dim>(b, center, size, t.spacing));
 }
 
@@ -137,6 +140,7 @@ void add_shaped_body(JsonReader& e, std::size_t k, int layers, const BodyTarget<
     add_particle(t.p, v, 0, ParticleKind::Boundary);
   }
   shaped_body_mass<Dim>(e, *shape, t.spacing, body, center);
+  add_guard_grid(*shape, t.spacing, depth, false, GuardMover{-1, static_cast<std::int32_t>(k)}, t.guard);
   t.regions.shape_keys.push_back(e.path());
   t.regions.all_shapes.push_back(*shape);
   t.regions.shape_margins.push_back(0);
@@ -194,7 +198,7 @@ void read_bodies(JsonReader& r, double spacing, const MeshFiles& files, Particle
   read_body_contact(r, spacing, cfg.rigid_bodies);
   if (!r.has("bodies")) return;
   auto br = r.child("bodies");
-  const BodyTarget<Dim, Real> target{br, spacing, files, budget, p, regions};
+  const BodyTarget<Dim, Real> target{br, spacing, files, budget, p, regions, cfg.guard};
   for (std::size_t k = 0; k < br.array_size(); ++k) {
     auto e = br.element(k);
     if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));

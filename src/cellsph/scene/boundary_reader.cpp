@@ -83,13 +83,15 @@ void read_walls(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, Pa
   cfg.guard.open_axis = open_top ? up : -1;
   regions.container = b;
   regions.container_key = wr.path();
+  regions.container_open_axis = open_top ? up : -1;
 }
 
 // A shaped obstacle: `layers` layers of boundary particles on the lattice inside its surface, or, with
-// "inside": true (a container), outside it.
+// "inside": true (a container), outside it; the solid guard keeps the fluid out of it.
 template <int Dim, class Real>
 void add_shape_walls(JsonReader& ob, JsonReader& e, std::size_t k, double spacing, ParticleBudget& budget,
-                     Particles<Dim, Real>& p, Regions<Dim>& regions, geometry::Shape shape) {
+                     Particles<Dim, Real>& p, Regions<Dim>& regions, geometry::Shape shape,
+                     std::int32_t motion, SolidGuard<Dim, Real>& guard) {
   const int layers = static_cast<int>(e.integer("layers", 3, 1, 10));
   const bool inside = e.boolean("inside", false);
   e.finish();
@@ -102,6 +104,7 @@ void add_shape_walls(JsonReader& ob, JsonReader& e, std::size_t k, double spacin
     for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
     add_particle(p, v, 0, ParticleKind::Boundary);
   }
+  add_guard_grid(shape, spacing, depth, inside, GuardMover{motion, -1}, guard);
   regions.shape_keys.push_back(e.path());
   regions.all_shapes.push_back(shape);
   regions.shape_margins.push_back(inside ? depth : 0);
@@ -125,7 +128,7 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
       cfg.wall_motion.of_particle.resize(p.size(), motion);
     };
     if (auto shape = read_shape<Dim>(e, spacing, files)) {
-      add_shape_walls(ob, e, k, spacing, budget, p, regions, std::move(*shape));
+      add_shape_walls(ob, e, k, spacing, budget, p, regions, std::move(*shape), motion, cfg.guard);
       mark_moving();
       continue;
     }
@@ -147,7 +150,7 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
         }
     regions.solids.push_back(b);
     regions.solid_keys.push_back(e.path());
-    if (motion < 0) cfg.guard.boxes.push_back({to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi)});
+    cfg.guard.boxes.push_back({to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), GuardMover{motion, -1}});
     mark_moving();
   }
 }
@@ -158,12 +161,12 @@ template <int Dim, class Real>
 Regions<Dim> read_boundary(JsonReader& r, double spacing, const MeshFiles& files,
                            SolverConfig<Dim, Real>& cfg, ParticleBudget& budget, Particles<Dim, Real>& p) {
   Regions<Dim> regions;
+  cfg.guard.depth = static_cast<Real>(kGuardDepth * spacing);
+  cfg.guard.margin = static_cast<Real>(kGuardMargin * spacing);
   if (!r.has("boundary")) return regions;
   auto br = r.child("boundary");
   cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
   cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic"}));
-  cfg.guard.depth = static_cast<Real>(kGuardDepth * spacing);
-  cfg.guard.margin = static_cast<Real>(kGuardMargin * spacing);
   read_box_boundary(br, spacing, cfg, regions);
   read_planes(br, cfg);
   read_walls(br, spacing, cfg, budget, p, regions);

@@ -97,6 +97,7 @@ struct Regions {
   std::vector<std::string> solid_keys;  // their key paths, for messages
   std::optional<Aabb<Dim>> container;   // region fluid must lie in
   std::string container_key;            // the walls' key path when walls make it (box or walls)
+  int container_open_axis = -1;         // the walls' open top: no wall on the hi face of this axis
   // Shaped obstacles and containers (boundary.obstacles with "mesh", "sphere" or "cylinder"): fluid
   // particles keep half a spacing outside every obstacle and inside some container.
   std::vector<geometry::Shape> solid_shapes, container_shapes;
@@ -187,8 +188,8 @@ std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverC
                                                 const Particles<Dim, Real>& p);
 
 // Geometry the spacing resolves poorly (geometry_warnings.cpp): a gap narrower than two spacings between two
-// box obstacles or an obstacle and the tank's walls, an obstacle thinner than the kernel support. One
-// sentence each, naming the keys; nothing is changed.
+// obstacles (boxes or shapes) or an obstacle and the tank's walls, an obstacle thinner than the kernel
+// support. One sentence each, naming the keys; nothing is changed.
 template <int Dim>
 std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double spacing, double support);
 
@@ -197,6 +198,13 @@ std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double s
 // particles, and the surface itself.
 inline constexpr double kGuardDepth = 0.5;
 inline constexpr double kGuardMargin = 0.0;
+
+// Adds shaped solid `shape` to the solid guard (solid_guard_grid.cpp): its signed distance on a grid of
+// one spacing's pitch over its bounds grown by its wall layers (`wall_depth`) and two spacings, positive on
+// the fluid's side (outside, or inside a `container`), moved by `mover`.
+template <int Dim, class Real>
+void add_guard_grid(const geometry::Shape& shape, double spacing, double wall_depth, bool container,
+                    GuardMover mover, SolidGuard<Dim, Real>& guard);
 
 // /output, and the box drawn in pictures (output_reader.cpp).
 template <int Dim>

@@ -134,23 +134,71 @@ struct Plane {
   Real offset = 0;
 };
 
-// A box obstacle at rest that the solid guard keeps the fluid out of (boundary/solid_guard.hpp).
+// Where a moving solid is now (boundary/solid_guard.hpp): a point of it that was at x_rest in the scene is
+// at R x_rest + b, moving at u + w x (x - c). Double precision, 3 components (z = 0 and w along z in 2D).
+struct GuardFrame {
+  double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row major
+  double b[3] = {0, 0, 0};
+  double c[3] = {0, 0, 0};
+  double u[3] = {0, 0, 0};
+  double w[3] = {0, 0, 0};
+};
+
+// Which frame moves a guarded solid: a prescribed motion (WallMotions::motions), a floating body
+// (RigidBodies::bodies), or none (at rest). The frames are the motions' first, then the bodies'.
+struct GuardMover {
+  std::int32_t motion = -1;
+  std::int32_t body = -1;
+  [[nodiscard]] CELLSPH_HD std::int32_t frame(std::int32_t motions) const {
+    return motion >= 0 ? motion : (body >= 0 ? motions + body : -1);
+  }
+  [[nodiscard]] bool moves() const { return motion >= 0 || body >= 0; }
+};
+
+// A box obstacle or box body that the solid guard keeps the fluid out of (boundary/solid_guard.hpp),
+// where the scene placed it.
 template <int Dim, class Real>
 struct GuardBox {
   Vec<Dim, Real> lo{}, hi{};
+  GuardMover mover{};
+};
+
+// A shaped solid (sphere, cylinder, mesh; obstacle, container or body) as its signed distance on a grid
+// of nodes origin + pitch (i, j, k), where the scene placed it: the values (SolidGuard::grid_values,
+// from `first`, x fastest) are positive on the fluid's side (outside a solid, inside a container) and
+// clamped to +-band. A point off the grid is on the fluid's side of a solid and deep in a container's.
+template <int Dim, class Real>
+struct GuardGrid {
+  Vec<Dim, Real> origin{};
+  Real pitch = 0;
+  Real band = 0;
+  std::int32_t n[3] = {1, 1, 1};
+  std::uint64_t first = 0;
+  bool container = false;
+  GuardMover mover{};
 };
 
 // The solids no fluid particle may end a step inside (boundary/solid_guard.hpp): the tank of
-// boundary.walls and the box obstacles at rest, and the distance kept from their surfaces.
+// boundary.walls, the box and shaped obstacles, containers and bodies, and the distance kept from their
+// surfaces.
 template <int Dim, class Real>
 struct SolidGuard {
   bool container = false;  // boundary.walls: the fluid stays inside [lo, hi]
   Vec<Dim, Real> lo{}, hi{};
   int open_axis = -1;  // the open top: no wall on the hi face of this axis; -1: closed
   std::vector<GuardBox<Dim, Real>> boxes{};
+  std::vector<GuardGrid<Dim, Real>> grids{};
+  std::vector<Real> grid_values{};
   Real depth = 0;   // how deep inside a solid a particle may end a step [m]
   Real margin = 0;  // how far on the fluid side of the surface it is put back [m]
-  [[nodiscard]] bool any() const { return container || !boxes.empty(); }
+  [[nodiscard]] bool any() const { return container || !boxes.empty() || !grids.empty(); }
+  [[nodiscard]] bool moving() const {
+    for (const auto& b : boxes)
+      if (b.mover.moves()) return true;
+    for (const auto& g : grids)
+      if (g.mover.moves()) return true;
+    return false;
+  }
 };
 
 template <int Dim, class Real>

@@ -19,6 +19,7 @@
 #include "cellsph/solver/boundary/akinci2012.hpp"
 #include "cellsph/solver/boundary/dynamic_crespo2007.hpp"
 #include "cellsph/solver/boundary/solid_guard.hpp"
+#include "cellsph/solver/boundary/solid_guard_frames.hpp"
 #include "cellsph/solver/boundary/wall_neighbors.hpp"
 #include "cellsph/solver/boundary/wall_states.hpp"
 #include "cellsph/solver/cell_order.hpp"
@@ -466,12 +467,20 @@ std::vector<std::string> Simulation<Dim, Real>::solver_summary() const {
   return stepper_->summary(dfsph_stats(), timings_.neighbors);
 }
 
-// The box and the planes (integration/collisions.hpp), then the solid guard (boundary/solid_guard.hpp).
+// The box and the planes (integration/collisions.hpp), then the solid guard (boundary/solid_guard.hpp)
+// with the moving solids where the step ends: the prescribed motions at the step's end time, the bodies
+// moved on by their velocities (boundary/solid_guard_frames.hpp). `dt`: the step's drift (0: fast particles
+// are not followed).
 template <int Dim, class Real>
-void Simulation<Dim, Real>::apply_walls() {
+void Simulation<Dim, Real>::apply_walls(Real dt) {
   if (cfg_.box.enabled || !cfg_.planes.empty()) run_pass(fluid_, box_plane_collisions(cfg_, view()));
-  if (cfg_.guard.any())
-    wall_corrections_ += static_cast<std::uint64_t>(reduce_sum(fluid_, solid_guard(cfg_.guard, view())));
+  if (!cfg_.guard.any()) return;
+  std::vector<GuardFrame> frames;
+  if (cfg_.guard.moving())
+    frames = guard_frames(cfg_, static_cast<double>(time_ + dt), static_cast<double>(dt), bodies_.states());
+  const auto pass = solid_guard(cfg_.guard, view(), frames.data(),
+                                static_cast<std::int32_t>(cfg_.wall_motion.motions.size()), dt);
+  wall_corrections_ += static_cast<std::uint64_t>(reduce_sum(fluid_, pass));
 }
 
 // After each step: the first particle (lowest index) with a non-finite quantity or outside the domain
@@ -599,7 +608,7 @@ void Simulation<Dim, Real>::step_per_particle() {
   sw.reset();
   per_particle_levels(cfg_, view(), due_list_, T, clock_.started);
   clock_.started = true;
-  apply_walls();
+  apply_walls(0);
   check_state();
   std::int64_t next = earliest_tick(view(), fluid_);
   if (next == std::numeric_limits<std::int64_t>::max()) next = T + (std::int64_t{1} << L);
@@ -642,7 +651,7 @@ void Simulation<Dim, Real>::step() {
     report_diverged_solve(e);
   }
   inflow_.hold(fluid_, p_.x.data(), p_.v.data(), dt);
-  apply_walls();
+  apply_walls(dt);
   check_state();
   time_ += dt;
   clock_.last_dt = dt;
@@ -964,6 +973,7 @@ void Simulation<Dim, Real>::step_device() {
   }
   DeviceStepInput<Real> in{time_, clock_, steps_ + 1};
   if (inflow_.activity(cfg_.inflow, double(time_))) in.emitters_active = inflow_.active_flags();
+  if (bodies_.any()) in.bodies = &bodies_.states();
   DeviceStepResult<Real> r{};
   try {
     r = device_->step(in);

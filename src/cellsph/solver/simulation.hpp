@@ -217,7 +217,7 @@ class Simulation {
   void compute_body_loads(const ParticleView<Dim, Real>& pv);
   // Host: the fluid split between the threads by row length, for the implicit solvers' sweeps.
   const BalancedIndexSet& fluid_by_pairs();
-  void apply_walls();
+  void apply_walls(Real dt);
   void check_state();
   [[noreturn]] void report_unstable(std::int64_t first) const;
   [[noreturn]] void report_diverged_solve(const SimulationError& e);

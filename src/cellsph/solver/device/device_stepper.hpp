@@ -20,6 +20,7 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/timer.hpp"
 #include "cellsph/solver/boundary/solid_guard.hpp"
+#include "cellsph/solver/boundary/solid_guard_frames.hpp"
 #include "cellsph/solver/boundary/wall_motion.hpp"
 #include "cellsph/solver/boundary/wall_states.hpp"
 #include "cellsph/solver/config.hpp"
@@ -113,6 +114,8 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
     phases_.upload(params.data(), params.size());
     planes_.upload(cfg_.planes.data(), cfg_.planes.size());
     guard_boxes_.upload(cfg_.guard.boxes.data(), cfg_.guard.boxes.size());
+    guard_grids_.upload(cfg_.guard.grids.data(), cfg_.guard.grids.size());
+    guard_values_.upload(cfg_.guard.grid_values.data(), cfg_.guard.grid_values.size());
     motions_.upload(cfg_.wall_motion.motions.data(), cfg_.wall_motion.motions.size());
     motion_rows_.upload(cfg_.wall_motion.rows.data(), cfg_.wall_motion.rows.size());
     std::vector<EmitterPlane<Dim, Real>> emitters;
@@ -227,8 +230,17 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
       run_pass(fluid, walls);
     }
     if (cfg_.guard.any()) {
-      auto guard = solid_guard(cfg_.guard, pv);
-      guard.boxes = guard_boxes_.data();  // the device's copy of cfg.guard.boxes
+      if (cfg_.guard.moving()) {  // as Simulation::apply_walls: the motions at the step's end
+        static const std::vector<RigidBodyState> none;
+        const auto frames = guard_frames(cfg_, static_cast<double>(in.time + r.dt), static_cast<double>(r.dt),
+                                         in.bodies ? *in.bodies : none);
+        guard_frames_.upload(frames.data(), frames.size());
+      }
+      auto guard = solid_guard(cfg_.guard, pv, guard_frames_.data(),
+                               static_cast<std::int32_t>(cfg_.wall_motion.motions.size()), r.dt);
+      guard.boxes = guard_boxes_.data();  // the device's copies of cfg.guard's solids
+      guard.grids = guard_grids_.data();
+      guard.grid_values = guard_values_.data();
       r.guard_corrections = reduce_sum(fluid, guard);
     }
     r.first_bad = first_where(fluid, stability_check(cfg_, pv));
@@ -407,6 +419,9 @@ class DeviceStepper final : public DeviceStepperBase<Dim, Real> {
   Array<PhaseParams<Real>> phases_;
   Array<Plane<Dim, Real>> planes_;
   Array<GuardBox<Dim, Real>> guard_boxes_;
+  Array<GuardGrid<Dim, Real>> guard_grids_;
+  Array<Real> guard_values_;
+  Array<GuardFrame> guard_frames_;  // this step's frames of the moving solids
   Array<std::uint32_t> fluid_, boundary_, identity_;
   std::vector<std::uint32_t> fluid_host_;
   // The model's stepper (models/model_registry.hpp), which owns the arrays only its model reads, and the

@@ -38,6 +38,8 @@ struct DeviceStepInput {
   // Emitters (emitters.hpp): per emitter 1 when it is active at the step's start (host memory, the
   // Simulation's); null when none is (no buffer is held).
   const std::uint8_t* emitters_active = nullptr;
+  // The floating bodies' states at the step's start (the solid guard's frames); null without bodies.
+  const std::vector<RigidBodyState>* bodies = nullptr;
 };
 
 // The device's neighbour rows copied to the host (tests, scripts/gpu_check.sh). Row i of a fluid particle
