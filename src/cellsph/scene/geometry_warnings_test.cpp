@@ -1,6 +1,6 @@
 // Under-resolved geometry is said when a scene loads (issue 52 item 5): gaps under two spacings between
-// box obstacles or an obstacle and the tank's walls, obstacles thinner than the kernel support. The
-// gaps and thicknesses are set here by hand.
+// obstacles (boxes and shapes) or an obstacle and the tank's walls, obstacles thinner than the kernel
+// support. The gaps and thicknesses are set here by hand.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -57,6 +57,48 @@ TEST(GeometryWarnings, AnObstacleThinnerThanTheSupport) {
       w[0].rfind("/boundary/obstacles/0: 0.03 m thick along x, thinner than the kernel support 0.04 m", 0),
       0U)
       << w[0];
+}
+
+nlohmann::json disc(double x, double y, double r) {
+  return {{"sphere", {{"center", {x, y}}, {"radius", r}}}};
+}
+
+TEST(GeometryWarnings, ShapesWellApartOrTouchingAreQuiet) {
+  // A disc 2.5 spacings above the floor; one resting on it (touching); one on the floor beside a box
+  // obstacle 3 spacings away.
+  EXPECT_TRUE(warnings_of(nlohmann::json::array({disc(0.5, 0.15, 0.1)})).empty());
+  EXPECT_TRUE(warnings_of(nlohmann::json::array({disc(0.5, 0.1, 0.1)})).empty());
+  EXPECT_TRUE(warnings_of(nlohmann::json::array({disc(0.5, 0.1, 0.1), box(0.66, 0, 0.8, 0.3)})).empty());
+}
+
+TEST(GeometryWarnings, ANarrowGapUnderADiscNamesTheDiscAndTheWalls) {
+  // The disc's lowest point 0.03 m (1.5 spacings) above the floor.
+  const auto w = warnings_of(nlohmann::json::array({disc(0.5, 0.13, 0.1)}));
+  ASSERT_EQ(w.size(), 1U);
+  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0 and /boundary/walls: a gap of about 0.03 m (1.5 spacings)", 0),
+            0U)
+      << w[0];
+}
+
+TEST(GeometryWarnings, ANarrowGapBetweenShapesAndABoxNamesBoth) {
+  // Two discs 0.025 m apart (1.25 spacings); the second 0.03 m from a box obstacle's face.
+  const auto w = warnings_of(
+      nlohmann::json::array({disc(0.3, 0.35, 0.1), disc(0.525, 0.35, 0.1), box(0.655, 0.2, 0.75, 0.5)}));
+  ASSERT_EQ(w.size(), 2U);
+  EXPECT_EQ(w[0].rfind("/boundary/obstacles/0 and /boundary/obstacles/1: a gap of about 0.025 m", 0), 0U)
+      << w[0];
+  EXPECT_EQ(w[1].rfind("/boundary/obstacles/1 and /boundary/obstacles/2: a gap of about 0.03 m", 0), 0U)
+      << w[1];
+}
+
+TEST(GeometryWarnings, AThinShapeIsSaid) {
+  // A 2D cylinder's section 0.03 m wide (under the 0.04 m support), 0.3 m tall: at most 0.03 m plus the
+  // half-spacing lattice's 0.01 m.
+  const auto w = warnings_of(nlohmann::json::parse(
+      R"([{"cylinder": {"base": [0.5, 0.3], "axis": [0, 1], "radius": 0.015, "height": 0.3}}])"));
+  ASSERT_EQ(w.size(), 1U);
+  EXPECT_NE(w[0].find("/boundary/obstacles/0: at most 0.0"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("thinner than the kernel support 0.04 m"), std::string::npos) << w[0];
 }
 
 }  // namespace
