@@ -1,11 +1,13 @@
 #pragma once
-// What the tests that run every built-in scene share: the scenes' names, and GoogleTest's name for a scene
-// parameter (dashes to underscores: `Builtin/SceneStart.X/dam_break_2d`).
+// What the tests that run every built-in scene share: the scenes' names, GoogleTest's name for a scene
+// parameter (dashes to underscores: `Builtin/SceneStart.X/dam_break_2d`), and a scene at another spacing.
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "cellsph/scene/builtin_scenes.hpp"
 
@@ -21,6 +23,22 @@ inline std::string scene_test_name(const ::testing::TestParamInfo<std::string>& 
   std::string n = info.param;
   std::replace(n.begin(), n.end(), '-', '_');
   return n;
+}
+
+// Scene j at f times its spacing: the support, the box's collision radius and any explicit particle mass
+// scale with it (mass as f^dim), so the scene keeps its rest density, support / spacing ratio and every
+// physical parameter; only the particle count changes.
+inline nlohmann::json scaled_scene(nlohmann::json j, double f) {
+  const int dim = j.value("dimension", 2);
+  const double s = j["spacing"].get<double>();
+  j["spacing"] = s * f;
+  auto& solver = j["solver"];
+  solver["support"] = solver.value("support", 2 * s) * f;
+  for (auto& ph : j["phases"])
+    if (ph.contains("mass")) ph["mass"] = ph["mass"].get<double>() * std::pow(f, dim);
+  if (j.contains("boundary") && j["boundary"].contains("box") && j["boundary"]["box"].contains("radius"))
+    j["boundary"]["box"]["radius"] = j["boundary"]["box"]["radius"].get<double>() * f;
+  return j;
 }
 
 }  // namespace cellsph::test

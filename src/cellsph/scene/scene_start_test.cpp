@@ -40,20 +40,6 @@
 namespace cellsph {
 namespace {
 
-// The scene with its spacing, support, given masses and box radius scaled by f (the physics unchanged).
-nlohmann::json scaled_scene(nlohmann::json j, double f) {
-  const int dim = j.value("dimension", 2);
-  const double s = j["spacing"].get<double>();
-  j["spacing"] = s * f;
-  auto& solver = j["solver"];
-  solver["support"] = solver.value("support", 2 * s) * f;
-  for (auto& ph : j["phases"])
-    if (ph.contains("mass")) ph["mass"] = ph["mass"].get<double>() * std::pow(f, dim);
-  if (j.contains("boundary") && j["boundary"].contains("box") && j["boundary"]["box"].contains("radius"))
-    j["boundary"]["box"]["radius"] = j["boundary"]["box"]["radius"].get<double>() * f;
-  return j;
-}
-
 // The largest speed the scene gives its fluid: the fluid blocks' velocities and the emitters'.
 double prescribed_speed(const nlohmann::json& j) {
   double v = 0;
@@ -190,7 +176,7 @@ TEST_P(SceneStart, AtCoarserSpacingsFluidStartsApartAndNeverFasterThanAFall) {
   const auto base = read_scene_json(GetParam(), src);
   const bool paper_dam_break = GetParam().rfind("paper-dam-break", 0) == 0;  // see the file's header
   for (const double f : {1.37, 1.5, 2.0}) {
-    const auto j = scaled_scene(base, f);
+    const auto j = test::scaled_scene(base, f);
     const bool speed = !(paper_dam_break && f == 2.0);
     if (read_scene_header(j, src).dim == 2)
       check_start<2>(j, GetParam(), speed);

@@ -22,6 +22,7 @@
 #include <iostream>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cellsph/core/error.hpp"
@@ -58,14 +59,7 @@ nlohmann::json coarsened(nlohmann::json j) {
   const double ratio = j["solver"].value("support", 2 * s) / s;
   const double target = ratio > 3 ? kTargetParticlesWide : kTargetParticles;
   const double f = std::max(1.0, std::pow(n / target, 1.0 / dim));
-  j["spacing"] = s * f;
-  auto& solver = j["solver"];
-  solver["support"] = solver.value("support", 2 * s) * f;
-  for (auto& ph : j["phases"])
-    if (ph.contains("mass")) ph["mass"] = ph["mass"].get<double>() * std::pow(f, dim);
-  if (j.contains("boundary") && j["boundary"].contains("box") && j["boundary"]["box"].contains("radius"))
-    j["boundary"]["box"]["radius"] = j["boundary"]["box"]["radius"].get<double>() * f;
-  return j;
+  return test::scaled_scene(std::move(j), f);
 }
 
 // Internal (elastic) energy per unit mass of the equation of state, u(rho) = int_rho0^rho p(r) / r^2 dr,
