@@ -12,9 +12,11 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "cellsph/scene/scene.hpp"
 #include "cellsph/solver/simulation.hpp"
+#include "cellsph/solver/solver_test_util.hpp"
 
 namespace cellsph {
 namespace {
@@ -211,6 +213,36 @@ TEST(SolidGuard, ALoneFastParticleStaysInAMeshContainer) {
       }
     }
     EXPECT_GT(sim.wall_corrections(), 0U);
+  }
+}
+
+// The guard's shapes, frames and path following on the host-emulated device: the CPU's bits and count.
+TEST(SolidGuard, TheHostEmulatedDeviceGivesTheCpusBits) {
+  auto disc = lone_particle("adami");
+  disc["boundary"]["obstacles"] =
+      nlohmann::json::parse(R"([{"sphere": {"center": [0.25, 0.5], "radius": 0.1}}])");
+  auto thin = lone_particle("adami");
+  thin["boundary"]["obstacles"] = nlohmann::json::parse(R"([{"min": [0.4, 0.2], "max": [0.42, 0.8]}])");
+  auto moving = lone_particle("adami");
+  moving["boundary"]["obstacles"] = nlohmann::json::parse(
+      R"([{"min": [0.1, 0.3], "max": [0.2, 0.7], "motion": {"translate": {"velocity": [30, 0], "end": 0.02}}}])");
+  auto body = lone_particle("adami");
+  body["bodies"] = nlohmann::json::parse(
+      R"([{"box": {"min": [0.1, 0.4], "max": [0.3, 0.6]}, "density": 50000, "velocity": [40, 0]}])");
+  for (const auto& [j, v] :
+       {std::pair{disc, Vec<2, double>{-60, -5}}, std::pair{thin, Vec<2, double>{-60, 0}},
+        std::pair{moving, Vec<2, double>{0, 0}}, std::pair{body, Vec<2, double>{0, 0}}}) {
+    auto s = load_scene<2, double>(j, "lone.json");
+    s.particles.v[the_fluid_particle(s.particles)] = v;
+    Simulation<2, double> cpu(s.solver, s.particles), dev(s.solver, s.particles);
+    dev.use_backend(Backend::HostDevice);
+    for (int step = 0; step < 25; ++step) {
+      cpu.step();
+      dev.step();
+    }
+    EXPECT_TRUE(test::same_state(cpu.particles(), dev.particles()));
+    EXPECT_GT(cpu.wall_corrections(), 0U);
+    EXPECT_EQ(cpu.wall_corrections(), dev.wall_corrections());
   }
 }
 
