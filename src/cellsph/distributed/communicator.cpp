@@ -3,6 +3,10 @@
 #include "cellsph/distributed/communicator.hpp"
 
 #include <cstdlib>
+#include <limits>
+#include <string>
+
+#include "cellsph/core/error.hpp"
 
 #if defined(CELLSPH_HAVE_MPI)
 #include <mpi.h>
@@ -137,6 +141,45 @@ std::vector<std::int64_t> Communicator::all_gather(const std::vector<std::int64_
   }
 #endif
   return local;
+}
+
+std::vector<std::byte> Communicator::all_to_all(const std::vector<std::vector<std::byte>>& to_rank,
+                                                std::vector<std::size_t>& from) const {
+  const int n = size();
+  CELLSPH_CHECK(static_cast<int>(to_rank.size()) == n,
+                "all_to_all: " << to_rank.size() << " messages for " << n << " ranks");
+#if defined(CELLSPH_HAVE_MPI)
+  if (g_active) {
+    const auto un = static_cast<std::size_t>(n);
+    std::vector<int> send_counts(un), send_offsets(un, 0), recv_counts(un), recv_offsets(un, 0);
+    std::vector<std::byte> send;
+    for (std::size_t r = 0; r < un; ++r) {
+      if (to_rank[r].size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+        throw SimulationError("rank " + std::to_string(rank()) + " has " + std::to_string(to_rank[r].size()) +
+                              " bytes for rank " + std::to_string(r) + ": over MPI's 2 GiB a message");
+      send_counts[r] = static_cast<int>(to_rank[r].size());
+      send_offsets[r] = static_cast<int>(send.size());
+      send.insert(send.end(), to_rank[r].begin(), to_rank[r].end());
+    }
+    MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    std::size_t total = 0;
+    from.assign(un, 0);
+    for (std::size_t r = 0; r < un; ++r) {
+      recv_offsets[r] = static_cast<int>(total);
+      from[r] = static_cast<std::size_t>(recv_counts[r]);
+      total += from[r];
+    }
+    if (total > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+      throw SimulationError("rank " + std::to_string(rank()) + " receives " + std::to_string(total) +
+                            " bytes: over MPI's 2 GiB in one exchange");
+    std::vector<std::byte> received(total);
+    MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, received.data(),
+                  recv_counts.data(), recv_offsets.data(), MPI_BYTE, MPI_COMM_WORLD);
+    return received;
+  }
+#endif
+  from.assign(1, to_rank[0].size());
+  return to_rank[0];
 }
 
 void Communicator::barrier() const {

@@ -4,6 +4,7 @@
 // with Open MPI where CMake finds it (option CELLSPH_MPI); without it, and in a process that no MPI
 // launcher started, there is one rank and every collective is the identity, so the single-process paths
 // need no branch.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -50,6 +51,11 @@ class Communicator {
   ExactSum sum(const ExactSum& local) const;
   // Every rank's values concatenated in rank order, on every rank.
   std::vector<std::int64_t> all_gather(const std::vector<std::int64_t>& local) const;
+  // Bytes for every rank exchanged (to_rank[r]: what this rank sends rank r; size() entries): what every
+  // rank sent this one, concatenated in rank order; from[r] the bytes that came from rank r. A message to
+  // one rank must stay under 2 GiB (MPI's int counts): a larger one is refused with a SimulationError.
+  std::vector<std::byte> all_to_all(const std::vector<std::vector<std::byte>>& to_rank,
+                                    std::vector<std::size_t>& from) const;
   void barrier() const;
 };
 
