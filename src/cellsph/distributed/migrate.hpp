@@ -28,22 +28,67 @@ void append(std::vector<std::byte>& out, const T& value) {
   out.insert(out.end(), b, b + sizeof(T));
 }
 
-// Every field of p permuted: element k becomes the old element from[k].
+}  // namespace migrate_detail
+
+// Appends to a message the particles `which` of p: their count, then field by field (the field list's
+// order) their elements.
 template <class Soa>
-void permute(Soa& p, const std::vector<std::size_t>& from) {
-  p.for_each_field([&](std::string_view, auto& field) {
-    auto old = field;
-    for (std::size_t k = 0; k < from.size(); ++k) field[k] = old[from[k]];
+void pack(const Soa& p, std::span<const std::size_t> which, std::vector<std::byte>& out) {
+  migrate_detail::append(out, static_cast<std::uint64_t>(which.size()));
+  const std::size_t n = p.size();
+  p.for_each_field([&](std::string_view name, const auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    static_assert(std::is_trivially_copyable_v<T>, "a field sent to another rank must be trivially copyable");
+    CELLSPH_CHECK(field.size() == n, "pack: field " << name << " has " << field.size() << " of " << n);
+    for (const std::size_t i : which) migrate_detail::append(out, field[i]);
   });
 }
 
-}  // namespace migrate_detail
+// Appends to p the particles of the messages in `in` (from[r] bytes from rank r, each a pack()), source
+// rank by source rank; returns how many came from each.
+template <class Soa>
+std::vector<std::uint64_t> unpack_append(Soa& p, const std::vector<std::byte>& in,
+                                         const std::vector<std::size_t>& from) {
+  std::vector<std::uint64_t> count(from.size());
+  std::size_t first = p.size(), total = p.size(), at = 0;
+  for (std::size_t r = 0; r < from.size(); ++r) {
+    std::memcpy(&count[r], in.data() + at, sizeof(std::uint64_t));
+    total += count[r];
+    at += from[r];
+  }
+  p.resize(total);
+  at = 0;
+  for (std::size_t r = 0; r < from.size(); ++r) {
+    std::size_t pos = at + sizeof(std::uint64_t);
+    p.for_each_field([&](std::string_view, auto& field) {
+      using T = typename std::decay_t<decltype(field)>::value_type;
+      for (std::size_t k = 0; k < count[r]; ++k, pos += sizeof(T))
+        std::memcpy(&field[first + k], in.data() + pos, sizeof(T));
+    });
+    CELLSPH_CHECK(pos == at + from[r], "unpack: a message from rank " << r << " of " << from[r] << " bytes");
+    at += from[r];
+    first += count[r];
+  }
+  return count;
+}
+
+// Sorts every field of p by id; returns the permutation (element k is the old element order[k]).
+template <class Soa>
+std::vector<std::size_t> sort_by_id(Soa& p) {
+  std::vector<std::size_t> order(p.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+  p.for_each_field([&](std::string_view, auto& field) {
+    auto old = field;
+    for (std::size_t k = 0; k < order.size(); ++k) field[k] = old[order[k]];
+  });
+  return order;
+}
 
 // Sends particle i of this rank to rank dest[i] (one entry per particle, each in [0, ranks)); afterwards
 // this rank holds every particle sent to it by any rank (itself included), in ascending id order.
 template <class Soa>
 void migrate(Soa& p, std::span<const int> dest, const Communicator& comm) {
-  using namespace migrate_detail;
   const std::size_t n = p.size();
   const auto ranks = static_cast<std::size_t>(comm.size());
   CELLSPH_CHECK(dest.size() == n, "migrate: " << dest.size() << " destinations for " << n << " particles");
@@ -53,45 +98,13 @@ void migrate(Soa& p, std::span<const int> dest, const Communicator& comm) {
                   "migrate: particle " << i << " to rank " << dest[i] << " of " << ranks);
     leaving[static_cast<std::size_t>(dest[i])].push_back(i);
   }
-  // Each message: the count, then field by field (the field list's order) the particles' elements.
   std::vector<std::vector<std::byte>> to_rank(ranks);
-  for (std::size_t r = 0; r < ranks; ++r) {
-    append(to_rank[r], static_cast<std::uint64_t>(leaving[r].size()));
-    p.for_each_field([&](std::string_view name, const auto& field) {
-      using T = typename std::decay_t<decltype(field)>::value_type;
-      static_assert(std::is_trivially_copyable_v<T>, "a migrated field must be trivially copyable");
-      CELLSPH_CHECK(field.size() == n, "migrate: field " << name << " has " << field.size() << " of " << n);
-      for (const std::size_t i : leaving[r]) append(to_rank[r], field[i]);
-    });
-  }
+  for (std::size_t r = 0; r < ranks; ++r) pack(p, std::span<const std::size_t>(leaving[r]), to_rank[r]);
   std::vector<std::size_t> from;
   const std::vector<std::byte> in = comm.all_to_all(to_rank, from);
-  // The arrivals, source rank by source rank.
-  std::vector<std::uint64_t> count(from.size());
-  std::size_t total = 0, at = 0;
-  for (std::size_t r = 0; r < from.size(); ++r) {
-    std::memcpy(&count[r], in.data() + at, sizeof(std::uint64_t));
-    total += count[r];
-    at += from[r];
-  }
-  p.resize(total);
-  at = 0;
-  std::size_t first = 0;
-  for (std::size_t r = 0; r < from.size(); ++r) {
-    std::size_t pos = at + sizeof(std::uint64_t);
-    p.for_each_field([&](std::string_view, auto& field) {
-      using T = typename std::decay_t<decltype(field)>::value_type;
-      for (std::size_t k = 0; k < count[r]; ++k, pos += sizeof(T))
-        std::memcpy(&field[first + k], in.data() + pos, sizeof(T));
-    });
-    CELLSPH_CHECK(pos == at + from[r], "migrate: a message from rank " << r << " of " << from[r] << " bytes");
-    at += from[r];
-    first += count[r];
-  }
-  std::vector<std::size_t> order(total);
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
-  permute(p, order);
+  p.resize(0);
+  unpack_append(p, in, from);
+  sort_by_id(p);
 }
 
 }  // namespace cellsph::distributed
