@@ -48,6 +48,19 @@ Particles<3, double> whole_set() {
   return p;
 }
 
+// Particle i of `from`, every field, appended to `to`.
+void append_particle(Particles<3, double>& to, const Particles<3, double>& from, std::size_t i) {
+  const std::size_t k = to.size();
+  to.resize(k + 1);
+  to.for_each_field([&](std::string_view name, auto& field) {
+    from.for_each_field([&](std::string_view n2, const auto& f2) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(field)>, std::decay_t<decltype(f2)>>) {
+        if (name == n2) field[k] = f2[i];
+      }
+    });
+  });
+}
+
 // The particle's key on the curve: the Z-order of its cell, 2^20 cells an axis.
 std::uint64_t key_of(const Vec<3, double>& x) {
   std::uint64_t c[3];
@@ -72,14 +85,7 @@ TEST(Migrate, ParticlesReachTheirRanksWithEveryFieldInIdOrder) {
   std::vector<std::int64_t> my_weight;
   for (std::size_t i = 0; i < all.size(); ++i)
     if (static_cast<int>(i % std::size_t(w.size())) == w.rank()) {
-      const std::size_t k = mine.size();
-      mine.resize(k + 1);
-      mine.for_each_field([&](std::string_view name, auto& field) {
-        all.for_each_field([&](std::string_view n2, const auto& f2) {
-          if constexpr (std::is_same_v<std::decay_t<decltype(field)>, std::decay_t<decltype(f2)>>)
-            if (name == n2) field[k] = f2[i];
-        });
-      });
+      append_particle(mine, all, i);
       my_keys.push_back(keys[i]);
       my_weight.push_back(weight[i]);
     }
@@ -120,15 +126,7 @@ Particles<3, double> my_share(const Particles<3, double>& all, const CurveGrid<3
   std::vector<std::int64_t> weight;
   for (std::size_t i = 0; i < all.size(); ++i)
     if (static_cast<int>(i % std::size_t(w.size())) == w.rank()) {
-      const std::size_t k = mine.size();
-      mine.resize(k + 1);
-      mine.for_each_field([&](std::string_view name, auto& field) {
-        all.for_each_field([&](std::string_view n2, const auto& f2) {
-          if constexpr (std::is_same_v<std::decay_t<decltype(field)>, std::decay_t<decltype(f2)>>) {
-            if (name == n2) field[k] = f2[i];
-          }
-        });
-      });
+      append_particle(mine, all, i);
       keys.push_back(grid.key(all.x[i]));
       weight.push_back(1);
     }
