@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include <unistd.h>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -119,7 +120,31 @@ void BM_MeshToParticles(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * (fluid + walls)));
 }
 
+// The solid guard's distance grid of the same mesh (scene/solid_guard_grid.cpp): one spacing's pitch over
+// its bounds grown by three spacings, exact distances within three spacings of the surface.
+void BM_MeshGuardGrid(benchmark::State& state) {
+  TriangleMesh m = read_mesh_file(stl_file(static_cast<int>(state.range(0))), "icosphere.stl");
+  check_closed(m, "icosphere.stl");
+  const Shape s = Shape::mesh(std::move(m), kSpacing);
+  const double band = 3 * kSpacing;
+  std::array<long, 3> n{};
+  P3 origin{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    origin[a] = s.lo()[a] - band;
+    n[a] = static_cast<long>(std::ceil((s.hi()[a] - s.lo()[a] + 2 * band) / kSpacing)) + 1;
+  }
+  std::size_t nodes = 0;
+  for (auto _ : state) {
+    const auto grid = signed_distance_grid(s, origin, kSpacing, n, band);
+    nodes = grid.size();
+    benchmark::DoNotOptimize(grid.data());
+  }
+  state.counters["nodes"] = double(nodes);
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * nodes));
+}
+
 BENCHMARK(BM_MeshReadAndCheck)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MeshGuardGrid)->Arg(6)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_MeshToParticles)->Arg(6)->Arg(7)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

@@ -416,13 +416,25 @@ std::vector<double> signed_distance_grid(const Shape& s, const P3& origin, doubl
   const std::size_t rows = static_cast<std::size_t>(n[1] * n[2]), row = static_cast<std::size_t>(n[0]);
   std::vector<double> out(rows * row, band);
   parallel_chunks(rows, 16, [&](std::size_t r0, std::size_t r1) {
+    std::vector<double> xs;
     for (std::size_t r = r0; r < r1; ++r) {
       const long j = static_cast<long>(r) % n[1], k = static_cast<long>(r) / n[1];
+      const double y = origin[1] + double(j) * pitch, z = s.dim() == 3 ? origin[2] + double(k) * pitch : 0.0;
+      // A mesh's side from the row's crossings, found once a row (as sample() does).
+      if (s.kind_ == Shape::Kind::Mesh) s.mesh_->crossings(y, z, xs);
       for (std::size_t i = 0; i < row; ++i) {
-        const P3 p{origin[0] + double(i) * pitch, origin[1] + double(j) * pitch,
-                   s.dim() == 3 ? origin[2] + double(k) * pitch : 0.0};
-        const Side side = s.classify(p, band);
-        const double d = std::min(side.distance, band);
+        const P3 p{origin[0] + double(i) * pitch, y, z};
+        Side side;
+        if (s.kind_ == Shape::Kind::Mesh) {
+          const auto above = std::upper_bound(xs.begin(), xs.end(), p[0]);
+          const double eps = s.mesh_->on_surface();
+          const bool on = above != xs.begin() && *(above - 1) == p[0];
+          side.distance = on ? 0 : s.mesh_->distance(p, std::max(band, eps));
+          side.sign = on || side.distance <= eps ? 0 : ((xs.end() - above) % 2 ? -1 : 1);
+        } else {
+          side = s.classify(p, band);
+        }
+        const double d = side.sign == 0 ? 0 : std::min(side.distance, band);
         out[r * row + i] = side.sign < 0 ? -d : d;
       }
     }

@@ -140,7 +140,7 @@ void add_shaped_body(JsonReader& e, std::size_t k, int layers, const BodyTarget<
     add_particle(t.p, v, 0, ParticleKind::Boundary);
   }
   shaped_body_mass<Dim>(e, *shape, t.spacing, body, center);
-  add_guard_grid(*shape, t.spacing, depth, false, GuardMover{-1, static_cast<std::int32_t>(k)}, t.guard);
+  add_guard_grid(*shape, t.spacing, false, GuardMover{-1, static_cast<std::int32_t>(k)}, t.guard);
   t.regions.shape_keys.push_back(e.path());
   t.regions.all_shapes.push_back(*shape);
   t.regions.shape_margins.push_back(0);

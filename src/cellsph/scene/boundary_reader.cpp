@@ -104,7 +104,7 @@ void add_shape_walls(JsonReader& ob, JsonReader& e, std::size_t k, double spacin
     for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
     add_particle(p, v, 0, ParticleKind::Boundary);
   }
-  add_guard_grid(shape, spacing, depth, inside, GuardMover{motion, -1}, guard);
+  add_guard_grid(shape, spacing, inside, GuardMover{motion, -1}, guard);
   regions.shape_keys.push_back(e.path());
   regions.all_shapes.push_back(shape);
   regions.shape_margins.push_back(inside ? depth : 0);

@@ -199,12 +199,15 @@ std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double s
 inline constexpr double kGuardDepth = 0.5;
 inline constexpr double kGuardMargin = 0.0;
 
+// How far from a shaped solid's surface the solid guard's grid holds exact distances, in spacings.
+inline constexpr double kGuardGridBand = 3.0;
+
 // Adds shaped solid `shape` to the solid guard (solid_guard_grid.cpp): its signed distance on a grid of
-// one spacing's pitch over its bounds grown by its wall layers (`wall_depth`) and two spacings, positive on
-// the fluid's side (outside, or inside a `container`), moved by `mover`.
+// one spacing's pitch over its bounds grown by kGuardGridBand spacings, positive on the fluid's side
+// (outside, or inside a `container`), moved by `mover`.
 template <int Dim, class Real>
-void add_guard_grid(const geometry::Shape& shape, double spacing, double wall_depth, bool container,
-                    GuardMover mover, SolidGuard<Dim, Real>& guard);
+void add_guard_grid(const geometry::Shape& shape, double spacing, bool container, GuardMover mover,
+                    SolidGuard<Dim, Real>& guard);
 
 // /output, and the box drawn in pictures (output_reader.cpp).
 template <int Dim>

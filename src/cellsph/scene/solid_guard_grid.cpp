@@ -6,11 +6,13 @@
 namespace cellsph::scene_detail {
 
 template <int Dim, class Real>
-void add_guard_grid(const geometry::Shape& shape, double spacing, double wall_depth, bool container,
-                    GuardMover mover, SolidGuard<Dim, Real>& guard) {
-  // The band holds the wall layers and the two spacings beyond them that a particle may reach in one
-  // step before the walls' pressure stops it; the grid covers it on every side.
-  const double band = wall_depth + 2 * spacing, pitch = spacing;
+void add_guard_grid(const geometry::Shape& shape, double spacing, bool container, GuardMover mover,
+                    SolidGuard<Dim, Real>& guard) {
+  // Distances are exact within a band of three spacings (clamped beyond): the guard acts from half a
+  // spacing deep and trusts the gradient to two spacings deep (SolidGuardPass::keep_out_of_grid); a
+  // particle deeper than that got there in one step and goes back to where it started it. A wider band
+  // costs more at load: every node within it asks the mesh for its nearest triangle.
+  const double band = kGuardGridBand * spacing, pitch = spacing;
   GuardGrid<Dim, Real> g;
   geometry::P3 origin{0, 0, 0};
   std::array<long, 3> n{1, 1, 1};
@@ -31,9 +33,8 @@ void add_guard_grid(const geometry::Shape& shape, double spacing, double wall_de
   guard.grids.push_back(g);
 }
 
-#define CELLSPH_GUARD_GRID_INSTANTIATE(D, R)                                                   \
-  template void add_guard_grid<D, R>(const geometry::Shape&, double, double, bool, GuardMover, \
-                                     SolidGuard<D, R>&);
+#define CELLSPH_GUARD_GRID_INSTANTIATE(D, R) \
+  template void add_guard_grid<D, R>(const geometry::Shape&, double, bool, GuardMover, SolidGuard<D, R>&);
 CELLSPH_GUARD_GRID_INSTANTIATE(2, float)
 CELLSPH_GUARD_GRID_INSTANTIATE(2, double)
 CELLSPH_GUARD_GRID_INSTANTIATE(3, float)
