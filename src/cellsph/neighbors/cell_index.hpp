@@ -108,72 +108,10 @@ class CellIndex {
     const Bounds b = bounds(x, h, radius);
     hmax_ = b.hmax;
     uniform_h_ = b.hmin == b.hmax;
-    // h' = (max h / H) * inflation (section 4.1); any positive size is exact when all h are 0. The
-    // size is kept in [kMinCellSize, kMaxCellSize] (hmask.hpp says why). A support whose square
-    // overflows Real makes every point its neighbour (distance2 <= inf): then one cell holds them all.
-    cell_size_ = b.hmax > Real(0) ? double(b.hmax) / subdivision_ * kCellInflation : 1.0;
-    cell_size_ = std::clamp(cell_size_, kMinCellSize<Real>, kMaxCellSize);
-    const bool one_cell = !std::isfinite(b.hmax * b.hmax);
-    const double reach = one_cell ? 0.0 : double(b.hmax) / cell_size_;
-    mask_ = h_mask<Dim>(reach);
-    const int pad = mask_radius(reach);
+    const int pad = set_cells_and_mask(b);
     for (int k = 0; k < Dim; ++k) origin_[k] = double(b.lo[k]);
-    if constexpr (kBand) {
-      // Stored coordinates are x - origin_ (in [0, extent]) rounded to float: within extent 2^-24
-      // of it, or float's subnormal spacing near 0 (band() uses twice both). Beyond 1e36 (float's
-      // range) the band is infinite: every candidate is tested again in double.
-      double extent = 0;
-      for (int k = 0; k < Dim; ++k) extent = std::max(extent, double(b.hi[k]) - double(b.lo[k]));
-      band_m_ =
-          extent <= 1e36 ? 4 * std::max(extent * 0x1p-23, 0x1p-140) : std::numeric_limits<double>::infinity();
-      band(hmax_, lo2_, hi2_);
-      band(Real(0), lo2_zero_, hi2_zero_);
-      xd_ = x.data();
-    }
-
-    // Bits per axis: cell coordinates are shifted by `pad` so that every mask target (home + offset)
-    // is non-negative and below 2^bits on every axis; targets off the grid then simply find no cell.
-    // An axis spanning more cells than fit (2^32 per axis, 64 bits in all) is cut: its last cell
-    // takes every farther point (cell_key clamps). Clamping never moves two points' cells further
-    // apart, so every pair within h stays within mask reach: exact for any finite input, and only
-    // slower for such extreme spreads (one far outlier costs nothing: it is alone in its cell).
-    const auto pad2 = 2 * static_cast<std::uint64_t>(pad);
-    std::array<int, Dim> bits{};
-    for (int k = 0; k < Dim; ++k) {
-      const double cells = std::floor((double(b.hi[k]) - origin_[k]) / cell_size_) + 1.0;
-      const double most = 4294967296.0 - double(pad2);  // top = cells - 1 + 2 pad < 2^32
-      axis_cells_[k] = one_cell       ? 1
-                       : cells < most ? static_cast<std::uint64_t>(cells)
-                                      : static_cast<std::uint64_t>(most);
-      bits[k] = static_cast<int>(std::bit_width(axis_cells_[k] - 1 + pad2));
-    }
-    auto total_bits = [&] {
-      int t = 0;
-      for (int k = 0; k < Dim; ++k) t += bits[k];
-      return t;
-    };
-    while (total_bits() > 64) {
-      const int k = static_cast<int>(std::max_element(bits.begin(), bits.end()) - bits.begin());
-      --bits[k];  // top = 2^bits - 1
-      axis_cells_[k] = (std::uint64_t{1} << bits[k]) - pad2;
-    }
-    int cell_bits = 0;
-    for (int k = 0; k < Dim; ++k) {
-      shift_[k] = cell_bits;
-      cell_bits += bits[k];
-    }
-    cell_bits_ = cell_bits;
-    index_bits_ = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(n_)));  // 2^I > N (eq. 17)
-    wide_ = force_wide_ || index_bits_ + cell_bits > 64;
-
-    deltas_.resize(mask_.size());
-    for (std::size_t m = 0; m < mask_.size(); ++m) {
-      std::uint64_t d = 0;  // two's complement wrap: home + d is exact for in-range targets
-      for (int k = 0; k < Dim; ++k)
-        d += static_cast<std::uint64_t>(static_cast<std::int64_t>(mask_[m].offset[k])) << shift_[k];
-      deltas_[m] = d;
-    }
-
+    if constexpr (kBand) set_float_band(b, x);
+    set_key_layout(b, pad);
     sort_particles(x, pad);
     gather(x, h);
   }
@@ -406,6 +344,76 @@ class CellIndex {
     }
     CELLSPH_CHECK(finite, "cell-index: non-finite coordinate or support length, or negative support length");
     return all;
+  }
+
+  // The cell size h' = (max h / H) * inflation (section 4.1) and the H-mask for it; returns the mask's
+  // reach in cells (the padding of the cell coordinates). Any positive size is exact when all h are 0.
+  // The size is kept in [kMinCellSize, kMaxCellSize] (hmask.hpp says why). A support whose square
+  // overflows Real makes every point its neighbour (distance2 <= inf): then one cell holds them all.
+  int set_cells_and_mask(const Bounds& b) {
+    cell_size_ = b.hmax > Real(0) ? double(b.hmax) / subdivision_ * kCellInflation : 1.0;
+    cell_size_ = std::clamp(cell_size_, kMinCellSize<Real>, kMaxCellSize);
+    one_cell_ = !std::isfinite(b.hmax * b.hmax);
+    const double reach = one_cell_ ? 0.0 : double(b.hmax) / cell_size_;
+    mask_ = h_mask<Dim>(reach);
+    return mask_radius(reach);
+  }
+
+  // Stored coordinates are x - origin_ (in [0, extent]) rounded to float: within extent 2^-24 of it, or
+  // float's subnormal spacing near 0 (band() uses twice both). Beyond 1e36 (float's range) the band is
+  // infinite: every candidate is tested again in double.
+  void set_float_band(const Bounds& b, std::span<const Point> x) {
+    double extent = 0;
+    for (int k = 0; k < Dim; ++k) extent = std::max(extent, double(b.hi[k]) - double(b.lo[k]));
+    band_m_ =
+        extent <= 1e36 ? 4 * std::max(extent * 0x1p-23, 0x1p-140) : std::numeric_limits<double>::infinity();
+    band(hmax_, lo2_, hi2_);
+    band(Real(0), lo2_zero_, hi2_zero_);
+    xd_ = x.data();
+  }
+
+  // Bits per axis: cell coordinates are shifted by `pad` so that every mask target (home + offset) is
+  // non-negative and below 2^bits on every axis; targets off the grid then simply find no cell. An axis
+  // spanning more cells than fit (2^32 per axis, 64 bits in all) is cut: its last cell takes every farther
+  // point (cell_key clamps). Clamping never moves two points' cells further apart, so every pair within h
+  // stays within mask reach: exact for any finite input, and only slower for such extreme spreads (one far
+  // outlier costs nothing: it is alone in its cell). Then each mask cell's key offset.
+  void set_key_layout(const Bounds& b, int pad) {
+    const auto pad2 = 2 * static_cast<std::uint64_t>(pad);
+    std::array<int, Dim> bits{};
+    for (int k = 0; k < Dim; ++k) {
+      const double cells = std::floor((double(b.hi[k]) - origin_[k]) / cell_size_) + 1.0;
+      const double most = 4294967296.0 - double(pad2);  // top = cells - 1 + 2 pad < 2^32
+      axis_cells_[k] = one_cell_      ? 1
+                       : cells < most ? static_cast<std::uint64_t>(cells)
+                                      : static_cast<std::uint64_t>(most);
+      bits[k] = static_cast<int>(std::bit_width(axis_cells_[k] - 1 + pad2));
+    }
+    auto total_bits = [&] {
+      int t = 0;
+      for (int k = 0; k < Dim; ++k) t += bits[k];
+      return t;
+    };
+    while (total_bits() > 64) {
+      const int k = static_cast<int>(std::max_element(bits.begin(), bits.end()) - bits.begin());
+      --bits[k];  // top = 2^bits - 1
+      axis_cells_[k] = (std::uint64_t{1} << bits[k]) - pad2;
+    }
+    int cell_bits = 0;
+    for (int k = 0; k < Dim; ++k) {
+      shift_[k] = cell_bits;
+      cell_bits += bits[k];
+    }
+    cell_bits_ = cell_bits;
+    index_bits_ = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(n_)));  // 2^I > N (eq. 17)
+    wide_ = force_wide_ || index_bits_ + cell_bits > 64;
+    deltas_.resize(mask_.size());
+    for (std::size_t m = 0; m < mask_.size(); ++m) {
+      std::uint64_t d = 0;  // two's complement wrap: home + d is exact for in-range targets
+      for (int k = 0; k < Dim; ++k)
+        d += static_cast<std::uint64_t>(static_cast<std::int64_t>(mask_[m].offset[k])) << shift_[k];
+      deltas_[m] = d;
+    }
   }
 
   std::uint64_t cell_key(const Point& p, int pad) const {
@@ -1075,6 +1083,7 @@ class CellIndex {
   std::uint32_t kept_order_max_ = kKeptOrderMax;
   std::size_t n_ = 0;
   bool wide_ = false;
+  bool one_cell_ = false;  // a support whose square overflows Real: one cell holds every point
   bool uniform_h_ = true;
   Real hmax_ = 0;
   double cell_size_ = 1.0;
