@@ -10,6 +10,12 @@ namespace cellsph::scene_detail {
 
 namespace {
 
+// Volume-map walls (solver/boundary/bender2019.hpp) are the solids' map: no wall particles.
+template <int Dim, class Real>
+bool wall_particles(const SolverConfig<Dim, Real>& cfg) {
+  return cfg.wall_model != WallModel::VolumeMap;
+}
+
 template <int Dim, class Real>
 void read_box_boundary(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, Regions<Dim>& regions) {
   if (!br.has("box")) return;
@@ -70,13 +76,15 @@ void read_walls(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, Pa
     outer *= n + 2 * layers;
     inner *= n;
   }
-  budget.take(outer - inner, br, "walls", "the walls");
   // The open face is the top as gravity sees it (scenes with y up in 3D), not always the last axis.
   int up = Dim - 1;
   for (int a = 0; a < Dim; ++a)
     if (std::abs(cfg.gravity[a]) > std::abs(cfg.gravity[up])) up = a;
-  add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
-                open_top, 0, weight, up);
+  if (wall_particles(cfg)) {
+    budget.take(outer - inner, br, "walls", "the walls");
+    add_box_walls(p, to_vec<Dim, Real>(b.lo), to_vec<Dim, Real>(b.hi), static_cast<Real>(spacing), layers,
+                  open_top, 0, weight, up);
+  }
   cfg.guard.container = true;
   cfg.guard.lo = to_vec<Dim, Real>(b.lo);
   cfg.guard.hi = to_vec<Dim, Real>(b.hi);
@@ -91,18 +99,20 @@ void read_walls(JsonReader& br, double spacing, SolverConfig<Dim, Real>& cfg, Pa
 template <int Dim, class Real>
 void add_shape_walls(JsonReader& ob, JsonReader& e, std::size_t k, double spacing, ParticleBudget& budget,
                      Particles<Dim, Real>& p, Regions<Dim>& regions, geometry::Shape shape,
-                     std::int32_t motion, SolidGuard<Dim, Real>& guard) {
+                     std::int32_t motion, bool particles, SolidGuard<Dim, Real>& guard) {
   const int layers = static_cast<int>(e.integer("layers", 3, 1, 10));
   const bool inside = e.boolean("inside", false);
   e.finish();
   const double depth = layers * spacing;
   const double estimate = 1.5 * shape.area() * depth / std::pow(spacing, Dim) + 8;
-  budget_shape<Dim>(budget, shape, spacing, inside ? depth : 0, estimate, ob, std::to_string(k),
-                    "this obstacle");
-  for (const auto& x : geometry::sample(shape, spacing, inside, depth)) {
-    Vec<Dim, Real> v;
-    for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
-    add_particle(p, v, 0, ParticleKind::Boundary);
+  if (particles) {
+    budget_shape<Dim>(budget, shape, spacing, inside ? depth : 0, estimate, ob, std::to_string(k),
+                      "this obstacle");
+    for (const auto& x : geometry::sample(shape, spacing, inside, depth)) {
+      Vec<Dim, Real> v;
+      for (int a = 0; a < Dim; ++a) v[a] = static_cast<Real>(x[static_cast<std::size_t>(a)]);
+      add_particle(p, v, 0, ParticleKind::Boundary);
+    }
   }
   add_guard_grid(shape, spacing, inside, GuardMover{motion, -1}, guard);
   regions.shape_keys.push_back(e.path());
@@ -128,7 +138,8 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
       cfg.wall_motion.of_particle.resize(p.size(), motion);
     };
     if (auto shape = read_shape<Dim>(e, spacing, files)) {
-      add_shape_walls(ob, e, k, spacing, budget, p, regions, std::move(*shape), motion, cfg.guard);
+      add_shape_walls(ob, e, k, spacing, budget, p, regions, std::move(*shape), motion, wall_particles(cfg),
+                      cfg.guard);
       mark_moving();
       continue;
     }
@@ -137,9 +148,11 @@ void read_obstacles(JsonReader& br, double spacing, const MeshFiles& files, Part
     const auto ax = lattice_of<Dim>(b, spacing, LatticeFit::Solid);
     for (std::size_t a = 0; a < Dim; ++a)
       if (ax[a].n < 1) e.fail("max", "obstacle is thinner than one particle spacing");
-    budget.take(double(ax[0].n) * double(ax[1].n) * double(ax[2].n), ob, std::to_string(k), "this obstacle");
+    if (wall_particles(cfg))
+      budget.take(double(ax[0].n) * double(ax[1].n) * double(ax[2].n), ob, std::to_string(k),
+                  "this obstacle");
     // A solid block of static boundary particles.
-    for (long kk = 0; kk < ax[2].n; ++kk)
+    for (long kk = 0; kk < (wall_particles(cfg) ? ax[2].n : 0); ++kk)
       for (long jj = 0; jj < ax[1].n; ++jj)
         for (long ii = 0; ii < ax[0].n; ++ii) {
           const long idx[3] = {ii, jj, kk};
@@ -166,7 +179,8 @@ Regions<Dim> read_boundary(JsonReader& r, double spacing, const MeshFiles& files
   if (!r.has("boundary")) return regions;
   auto br = r.child("boundary");
   cfg.no_slip = br.choice("slip", "free", {"free", "no-slip"}) == "no-slip";
-  cfg.wall_model = *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic"}));
+  cfg.wall_model =
+      *parse_wall_model(br.choice("model", "akinci", {"akinci", "adami", "dynamic", "volume-map"}));
   read_box_boundary(br, spacing, cfg, regions);
   read_planes(br, cfg);
   read_walls(br, spacing, cfg, budget, p, regions);

@@ -229,12 +229,14 @@ void wcsph_only_misfits(const nlohmann::json& j, Misfits& m) {
         "--set /solver/density_diffusion=null");
 }
 
-// DFSPH's and IISPH's limits (Akinci walls, no surface tension) and each one's settings section.
+// DFSPH's and IISPH's limits (Akinci or volume-map walls, no surface tension) and each one's settings
+// section.
 void implicit_misfits(const nlohmann::json& j, const std::string& name, Misfits& m) {
   const nlohmann::json* boundary = json_at(&j, "boundary");
-  if (const nlohmann::json* wm = json_at(boundary, "model"); wm && wm->is_string() && *wm != "akinci")
+  if (const nlohmann::json* wm = json_at(boundary, "model");
+      wm && wm->is_string() && *wm != "akinci" && *wm != "volume-map")
     m.add("/boundary/model is " + json_value_text(*wm) + " (" + name +
-              " holds Akinci 2012 boundary particles only)",
+              " holds Akinci 2012 boundary particles or volume maps)",
           "--set /boundary/model=akinci");
   if (const nlohmann::json* phases = json_at(&j, "phases"); phases && phases->is_array())
     for (std::size_t k = 0; k < phases->size(); ++k)

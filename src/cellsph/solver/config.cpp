@@ -136,9 +136,11 @@ void validate_implicit(const SolverConfig<Dim, Real>& c) {
   // Adami and dynamic walls take their pressure from the fluid's (extrapolated) or from an equation of
   // state; neither is an unknown of the DFSPH solves, so the factor alpha_i would not describe what a
   // sweep changes (docs/physics.md, "DFSPH").
-  if (c.wall_model != WallModel::Akinci)
+  if (c.wall_model != WallModel::Akinci && c.wall_model != WallModel::VolumeMap)
     bad("boundary.model", wall_model_name(c.wall_model),
-        ("the " + name + " model supports Akinci 2012 boundary particles only (boundary.model = akinci)")
+        ("the " + name +
+         " model takes Akinci 2012 boundary particles or volume maps (boundary.model = "
+         "akinci or volume-map)")
             .c_str());
   for (std::size_t k = 0; k < c.phases.size(); ++k)
     if (c.phases[k].sigma > 0)
@@ -221,6 +223,24 @@ void validate_inflow(const SolverConfig<Dim, Real>& c) {
 }
 }  // namespace
 
+// Volume-map walls (boundary/bender2019.hpp): what this first version of them covers.
+template <int Dim, class Real>
+void validate_volume_map(const SolverConfig<Dim, Real>& c) {
+  if (c.wall_model != WallModel::VolumeMap) return;
+  const auto no = [&](const char* key, std::string_view value, const char* what) {
+    bad(key, value, (std::string("volume-map walls (boundary.model = volume-map) ") + what).c_str());
+  };
+  if (!implicit_pressure(c.model))
+    no("model", model_name(c.model), "need the DFSPH or IISPH model (solver.model = dfsph or iisph)");
+  if (c.backend != Backend::Cpu)
+    no("backend", backend_name(c.backend), "run on the CPU only (solver.backend = cpu) for now");
+  if (c.guard.moving())
+    no("boundary.obstacles", "motion", "hold static solids only: a moving obstacle needs particle walls");
+  if (c.rigid_bodies.any()) no("bodies", "floating", "do not move floating bodies yet");
+  if (!c.volume_map.empty() && !(c.volume_map.pitch > 0 && c.volume_map.reach > 0))
+    bad("volume_map.pitch", c.volume_map.pitch, "must be positive with a positive reach");
+}
+
 template <int Dim, class Real>
 void SolverConfig<Dim, Real>::validate() const {
   validate_numbers(*this);
@@ -231,6 +251,7 @@ void SolverConfig<Dim, Real>::validate() const {
   validate_motion(*this);
   validate_bodies(*this);
   validate_inflow(*this);
+  validate_volume_map(*this);
 }
 
 std::string_view model_name(Model m) {
@@ -287,6 +308,8 @@ std::string_view wall_model_name(WallModel w) {
       return "adami";
     case WallModel::Dynamic:
       return "dynamic";
+    case WallModel::VolumeMap:
+      return "volume-map";
   }
   return "?";
 }
@@ -294,6 +317,7 @@ std::optional<WallModel> parse_wall_model(std::string_view n) {
   if (n == "akinci") return WallModel::Akinci;
   if (n == "adami") return WallModel::Adami;
   if (n == "dynamic") return WallModel::Dynamic;
+  if (n == "volume-map") return WallModel::VolumeMap;
   return std::nullopt;
 }
 std::string_view density_formulation_name(DensityFormulation d) {

@@ -114,6 +114,11 @@ enum class WallModel {
   // gradient of the total internal energy, fluid and walls (Monaghan 2005's Lagrangian with the wall
   // positions fixed), so walls do no net work. No slip: viscosity against a wall at rest.
   Dynamic,
+  // No wall particles: every solid of SolidGuard (the tank, boxes, shapes) is one map on a grid
+  // (boundary/bender2019.hpp, after Bender et al. 2019's volume maps): at each fluid particle the walls'
+  // kernel integral D = int_solid W, its gradient and the solid's share of the support ball, which the
+  // implicit models' density, solves and forces take as one wall neighbour. DFSPH and IISPH, static solids.
+  VolumeMap,
 };
 
 // One fluid (or boundary material): the phases table of a scene.
@@ -201,6 +206,35 @@ struct SolidGuard {
   }
 };
 
+// The solids as a volume map (WallModel::VolumeMap; boundary/bender2019.hpp builds and reads it). The
+// walls' kernel sums are those of the fluid's lattice continued into the solid in layers: the half-space's
+// profile (per entry kProfileColumns values at signed distance d in [-reach, reach], a step
+// `profile_step` apart); for the tank, exactly, its faces' profiles less their edges' and corners' overlaps
+// (tables over [-reach, reach]^2 and ^3, `table_count` entries per axis, each value and its derivative in
+// the first distance); the other solids (boxes, shapes) on a grid of nodes origin + pitch (i, j, k), x
+// fastest, each with kFields values: the equivalent distance (where a half-space has their D), its
+// gradient, and the difference of their F from the half-space's there. Built by the Simulation from the
+// SolidGuard when empty.
+template <int Dim, class Real>
+struct VolumeMap {
+  static constexpr int kFields = 2 + Dim;    // equivalent distance, its gradient, F's difference
+  static constexpr int kProfileColumns = 5;  // D, dD/dd, F, T's normal and tangential parts
+  bool built = false;
+  Real reach = 0;  // the kernel's support h: no solid acts on a particle farther than this
+  Real profile_step = 0;
+  std::vector<Real> profile{};
+  bool tank = false;
+  Vec<Dim, Real> lo{}, hi{};
+  int open_axis = -1;
+  std::int32_t table_count[2] = {0, 0};  // the edge (two faces) and corner (three faces) tables
+  std::vector<Real> edge{}, corner{};
+  Vec<Dim, Real> origin{};
+  Real pitch = 0;
+  std::int32_t n[3] = {1, 1, 1};
+  std::vector<Real> nodes{};
+  [[nodiscard]] bool empty() const { return !built; }
+};
+
 template <int Dim, class Real>
 struct SolverConfig {
   using V = Vec<Dim, Real>;
@@ -273,6 +307,8 @@ struct SolverConfig {
   WallModel wall_model = WallModel::Akinci;
   // Fluid particles put back out of the walls and obstacles they would end a step inside.
   SolidGuard<Dim, Real> guard{};
+  // WallModel::VolumeMap: the guard's solids as a map (built from `guard` when empty).
+  VolumeMap<Dim, Real> volume_map{};
   // Moving walls (boundary/wall_motion.hpp; scene key boundary.obstacles[k].motion): the prescribed
   // motions and which boundary particle each moves. Empty: every wall at rest. CPU steps only.
   WallMotions wall_motion{};

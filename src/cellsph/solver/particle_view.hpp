@@ -54,18 +54,27 @@ struct ParticleView {
   const V* wall_a = nullptr;      // moving walls (boundary/wall_motion.hpp): acceleration; null: all at rest
   Real* wall_self_rho = nullptr;  // dynamic walls: the fixed wall-wall part of the density
   Real* drho = nullptr;           // WCSPH continuity density: d rho / dt of this step
-  Real* df_alpha = nullptr;       // DFSPH (models/dfsph.hpp): 1 / (the factor's denominator)
-  Real* df_kappa = nullptr;       // DFSPH: this sweep's pressure / rho^2 increment
-  Real* df_kappa_v = nullptr;     // DFSPH: the divergence solve's pressure / rho^2 (warm start)
-  V* df_grad = nullptr;           // DFSPH: grad W_ij of each pair of the rows, at the pair's slot in `within`
-  V* df_gsum = nullptr;           // DFSPH: sum_j w_ij grad W_ij of the step (the density pass)
-  V* df_gwall = nullptr;          // DFSPH: its walls' part, sum_b w_ib grad W_ib
-  V* df_mv = nullptr;             // DFSPH: w_j v_j (the mass density's sweeps gather it)
-  Real* df_mk = nullptr;          // DFSPH: m_j k_j of the sweep, 0 for a wall
-  V* cg_v0 = nullptr;             // DFSPH's CG density solve (models/dfsph_cg.hpp): v before the kick by p
-  Real* cg_s = nullptr;           // DFSPH CG: the predicted density error s_i (signed)
-  Real* cg_p = nullptr;           // DFSPH CG: the search direction
-  Real* cg_ap = nullptr;          // DFSPH CG: (A p)_i
+  // Volume-map walls (boundary/bender2019.hpp), per fluid particle, null without them: the walls' part
+  // of the density and of its gradient, the equivalent wall particle's weight and x_i - x_b, and the
+  // particles the solids replace in the support, and rho0 T g (the hydrostatic wall pressure's term).
+  Real* vm_rho = nullptr;
+  V* vm_g = nullptr;
+  Real* vm_w = nullptr;
+  V* vm_x = nullptr;
+  Real* vm_count = nullptr;
+  V* vm_h = nullptr;
+  Real* df_alpha = nullptr;    // DFSPH (models/dfsph.hpp): 1 / (the factor's denominator)
+  Real* df_kappa = nullptr;    // DFSPH: this sweep's pressure / rho^2 increment
+  Real* df_kappa_v = nullptr;  // DFSPH: the divergence solve's pressure / rho^2 (warm start)
+  V* df_grad = nullptr;        // DFSPH: grad W_ij of each pair of the rows, at the pair's slot in `within`
+  V* df_gsum = nullptr;        // DFSPH: sum_j w_ij grad W_ij of the step (the density pass)
+  V* df_gwall = nullptr;       // DFSPH: its walls' part, sum_b w_ib grad W_ib
+  V* df_mv = nullptr;          // DFSPH: w_j v_j (the mass density's sweeps gather it)
+  Real* df_mk = nullptr;       // DFSPH: m_j k_j of the sweep, 0 for a wall
+  V* cg_v0 = nullptr;          // DFSPH's CG density solve (models/dfsph_cg.hpp): v before the kick by p
+  Real* cg_s = nullptr;        // DFSPH CG: the predicted density error s_i (signed)
+  Real* cg_p = nullptr;        // DFSPH CG: the search direction
+  Real* cg_ap = nullptr;       // DFSPH CG: (A p)_i
   std::uint8_t* cg_active = nullptr;  // DFSPH CG: 1 in the active set
 
   // Neighbour rows. The Verlet lists (within h + skin): candidates + offsets[i] .. candidates + offsets[i +

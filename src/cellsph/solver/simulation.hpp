@@ -226,6 +226,7 @@ class Simulation {
   void upload_to_device();
   void sync_host() const;
   void init_boundary_weights();
+  void build_wall_map();
   // Moving walls (boundary/moving_walls.hpp): their slots from the particles' ids (set_moving_slots), and
   // their state at time t (move_walls: position, velocity, acceleration).
   void set_moving_slots();

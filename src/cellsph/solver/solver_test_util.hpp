@@ -130,6 +130,7 @@ struct DfsphColumn {
   using V = Vec<Dim, double>;
   double s = 0.02, width = 0.4, depth = 0.4, support = 2, mu = 5, dt_max = 0.005;
   DfsphWallPressure walls = DfsphWallPressure::Hydrostatic;
+  bool volume_map = false;  // the tank as a volume map (boundary/bender2019.hpp), not wall particles
   static constexpr double rho0 = 1000, g = 9.81;
   // The WCSPH Courant step of the same resolution and support, 0.3 h / c with c = 10 sqrt(2 g depth) (the
   // dam-break scenes' sound speed and Courant number): what the "20x the WCSPH step" measures by.
@@ -141,6 +142,14 @@ struct DfsphColumn {
     cfg.domain_set = true;
     cfg.domain_lo = corner(-0.1, -0.1);
     cfg.domain_hi = corner(width + 0.1, 2 * depth);
+    if (volume_map) {
+      cfg.wall_model = WallModel::VolumeMap;
+      cfg.guard.container = true;
+      cfg.guard.lo = corner(0, 0);
+      cfg.guard.hi = corner(width, depth + 2 * s);
+      cfg.guard.open_axis = Dim - 1;
+      cfg.guard.depth = 0.5 * s;  // the scenes' (scene_readers.hpp, kGuardDepth)
+    }
     return cfg;
   }
   [[nodiscard]] Particles<Dim, double> particles() const {
@@ -148,7 +157,8 @@ struct DfsphColumn {
     add_block<Dim, double>(p, corner(0, 0), corner(width, depth), s, 0);
     double weight = rho0;
     for (int a = 0; a < Dim; ++a) weight *= s;
-    add_box_walls<Dim, double>(p, corner(0, 0), corner(width, depth + 2 * s), s, 2, true, 0, weight);
+    if (!volume_map)
+      add_box_walls<Dim, double>(p, corner(0, 0), corner(width, depth + 2 * s), s, 2, true, 0, weight);
     return p;
   }
   // The solver's pressure against rho0 g d, summed over the bottom row and over the lower half above it.

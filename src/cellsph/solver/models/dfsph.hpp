@@ -86,6 +86,7 @@ struct DfsphStats {
   // Wall time of the step's stages [ms, summed]: ms_divergence includes the non-pressure forces (summed in
   // the divergence solve's last pass), ms_nonpressure is their kick.
   double ms_factor = 0, ms_divergence = 0, ms_nonpressure = 0, ms_density = 0, ms_drift = 0;
+  double ms_walls = 0;  // volume-map walls: the step's look-up (boundary/bender2019.hpp)
 };
 
 // The step's kernel gradients of i's row, as the density pass stored them (df_grad, one per slot of the
@@ -129,6 +130,7 @@ CELLSPH_HD inline Real dfsph_density_rate(const ParticleView<Dim, Real>& pv, std
     d += continuity_term(*g, dfsph_weight(pv, number, i, j), vi - pv.v[j]);
     also(j, *g);
   }
+  if (pv.vm_g) d += continuity_term(pv.vm_g[i], Real(1), vi);  // volume-map walls, at rest
   return d;
 }
 
@@ -180,7 +182,8 @@ struct DfsphSourceRule {
     Real source = 0;
     if (density) {
       source = std::max(pv.rho[i] + dt * rate - rho0, Real(0));
-    } else if (pv.within_count[i] >= min_neighbors) {
+    } else if (pv.within_count[i] >= min_neighbors ||
+               (pv.vm_count && Real(pv.within_count[i]) + pv.vm_count[i] >= Real(min_neighbors))) {
       source = std::max(rate, Real(0));
     }
     Real k;
@@ -270,6 +273,11 @@ struct DfsphDensityFactorPass {
       sq += fluid ? norm2(mg) * ratio : Real(0);
       gwall += mg * (fluid ? Real(0) : Real(1));
     }
+    if (pv.vm_g) {  // volume-map walls (boundary/bender2019.hpp): one wall neighbour more, at rest
+      rho += pv.vm_rho[i];
+      grad += pv.vm_g[i];
+      gwall += pv.vm_g[i];
+    }
     // k_i's own effect on D rho_i / Dt: its kick is -dt k_i (G_i + B_i) with the walls mirrored (B_i their
     // part of G_i), -dt k_i G_i without; so the diagonal is (G_i + B_i) . G_i + sq, or |G_i|^2 + sq. Next
     // to a wall G_i is small and (G_i + B_i) . G_i may be negative: then sq alone, a larger diagonal than
@@ -335,6 +343,7 @@ struct DfsphPressureKickPass {
                                       : mirror       ? ki
                                                      : Real(0));
     }
+    if (pv.vm_g) f += symmetric_pressure_force(pv.vm_g[i], mi, Real(1), ki, mirror ? ki : Real(0));
     pv.v[i] += f * (dt / mi);
     pv.df_mv[i] = pv.v[i] * mi;
   }
@@ -378,7 +387,23 @@ struct DfsphNonPressurePass {
     // x_ib, with a_b a moving wall's acceleration (the wall's frame sees g - a_b, as Adami's walls do).
     if (hydrostatic) s.f += g * (pv.m[i] * wb * dot(pv.wall_gravity(gravity, j), xij) / s.rhoi);
   }
-  CELLSPH_HD void finish(const Sum& s, std::size_t i) const { pv.f[i] = s.f; }
+  CELLSPH_HD void finish(const Sum& s, std::size_t i) const {
+    if (pv.vm_w == nullptr || !(pv.vm_w[i] > 0)) {
+      pv.f[i] = s.f;
+      return;
+    }
+    // Volume-map walls (boundary/bender2019.hpp): the same wall terms with the equivalent wall particle,
+    // at rest (its weighted gradient w_b grad W_ib is vm_g).
+    const Real wb = pv.vm_w[i];
+    const V xib = pv.vm_x[i];
+    V f = s.f;
+    if (no_slip)
+      f += morris_viscosity_force(s.vi, V(pv.vm_g[i] / wb), xib, norm2(xib), s.vol_i, wb / s.rhoi, s.mui,
+                                  s.mui, eta2);
+    if (hydrostatic)
+      f += pv.vm_h[i] * (pv.m[i] / s.rhoi);  // rho0 T g: the walls' sum of w_b (g . x_ib) grad W_ib
+    pv.f[i] = f;
+  }
 
   CELLSPH_HD void operator()(std::size_t i) const {
     Sum s = begin(i);

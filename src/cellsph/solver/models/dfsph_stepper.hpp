@@ -8,9 +8,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cellsph/core/format.hpp"
+#include "cellsph/core/timer.hpp"
+#include "cellsph/solver/boundary/bender2019.hpp"
 #include "cellsph/solver/config.hpp"
 #include "cellsph/solver/models/dfsph.hpp"
 #include "cellsph/solver/models/model_stepper.hpp"
@@ -69,7 +72,30 @@ class ImplicitPressureStepper : public ModelStepper<Dim, Real, Ctx> {
     pv.cg_p = cg_p_.data();
     pv.cg_ap = cg_ap_.data();
     pv.cg_active = cg_active_.data();
+    if (c.cfg().wall_model == WallModel::VolumeMap) look_up_walls(c, pv);
     return pv;
+  }
+
+  // Volume-map walls (boundary/bender2019.hpp): each fluid particle's wall neighbour of the step.
+  void look_up_walls(Ctx& c, ParticleView<Dim, Real>& pv) {
+    const Stopwatch sw;
+    const std::size_t n = c.size();
+    for (auto* a : {&vm_rho_, &vm_w_, &vm_count_}) a->resize(n);
+    for (auto* a : {&vm_g_, &vm_x_, &vm_h_}) a->resize(n);
+    pv.vm_rho = vm_rho_.data();
+    pv.vm_g = vm_g_.data();
+    pv.vm_w = vm_w_.data();
+    pv.vm_x = vm_x_.data();
+    pv.vm_count = vm_count_.data();
+    pv.vm_h = vm_h_.data();
+    const auto& cfg = c.cfg();
+    const double ratio = double(cfg.support) / double(diameter_);
+    const auto full = static_cast<Real>(Dim == 3 ? 4.18879 * ratio * ratio * ratio : 3.14159 * ratio * ratio);
+    with_kernel<Dim, Real>(cfg.density_kernel, cfg.support, [&](const auto w) {
+      run_pass(c.fluid(), VolumeMapLookupPass<Dim, Real, std::remove_cvref_t<decltype(w)>>{
+                              pv, volume_map_view(cfg.volume_map), w, full, cfg.gravity});
+    });
+    stats_.ms_walls += sw.ms();
   }
 
   template <class T>
@@ -77,6 +103,8 @@ class ImplicitPressureStepper : public ModelStepper<Dim, Real, Ctx> {
   Array<Real> alpha_, kappa_, mk_;
   Array<Vec<Dim, Real>> grad_, gsum_, gwall_, mv_;
   Array<Real> cg_s_, cg_p_, cg_ap_;
+  Array<Real> vm_rho_, vm_w_, vm_count_;
+  Array<Vec<Dim, Real>> vm_g_, vm_x_, vm_h_;
   Array<Vec<Dim, Real>> cg_v0_;
   Array<std::uint8_t> cg_active_;
   Real diameter_ = 0;
@@ -103,10 +131,11 @@ class DfsphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
     return {"dfsph: " + format_number("%.2f", sweeps / n) + " density + " +
                 format_number("%.2f", double(st.divergence_iterations) / n) + " divergence sweeps/step, " +
                 implicit_errors_summary(st, bound_),
-            "dfsph ms/step: search " + format_number("%.3g", search_ms / n) + ", density+alpha " +
-                format_number("%.3g", st.ms_factor / n) + ", divergence solve + non-pressure forces " +
-                format_number("%.3g", st.ms_divergence / n) + ", kick " +
-                format_number("%.3g", st.ms_nonpressure / n) + ", density solve " +
+            "dfsph ms/step: search " + format_number("%.3g", search_ms / n) +
+                (st.ms_walls > 0 ? ", wall map " + format_number("%.3g", st.ms_walls / n) : std::string()) +
+                ", density+alpha " + format_number("%.3g", st.ms_factor / n) +
+                ", divergence solve + non-pressure forces " + format_number("%.3g", st.ms_divergence / n) +
+                ", kick " + format_number("%.3g", st.ms_nonpressure / n) + ", density solve " +
                 format_number("%.3g", st.ms_density / n) + ", drift " +
                 format_number("%.3g", st.ms_drift / n) + " (" +
                 format_number("%.3g", sweeps > 0 ? st.ms_density / sweeps : 0.0) + " ms a density sweep)"};
