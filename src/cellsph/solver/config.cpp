@@ -232,8 +232,6 @@ void validate_volume_map(const SolverConfig<Dim, Real>& c) {
   };
   if (!implicit_pressure(c.model))
     no("model", model_name(c.model), "need the DFSPH or IISPH model (solver.model = dfsph or iisph)");
-  if (c.backend != Backend::Cpu)
-    no("backend", backend_name(c.backend), "run on the CPU only (solver.backend = cpu) for now");
   if (c.guard.moving())
     no("boundary.obstacles", "motion", "hold static solids only: a moving obstacle needs particle walls");
   if (c.rigid_bodies.any()) no("bodies", "floating", "do not move floating bodies yet");

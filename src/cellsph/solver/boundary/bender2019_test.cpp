@@ -228,6 +228,13 @@ TEST(VolumeMap, RefusesWhatItDoesNotCover) {
   auto wcsph = c.config();
   wcsph.model = Model::Wcsph;
   EXPECT_THROW((Simulation<2, double>(wcsph, c.particles())), InputError);
+  {  // a device backend, at start or later
+    auto device = c.config();
+    device.backend = Backend::HostDevice;
+    EXPECT_THROW((Simulation<2, double>(device, c.particles())), InputError);
+    Simulation<2, double> sim(c.config(), c.particles());
+    EXPECT_THROW(sim.use_backend(Backend::HostDevice), InputError);
+  }
   c.volume_map = false;
   auto walls = c.particles();  // wall particles as well as the map
   c.volume_map = true;

@@ -103,6 +103,8 @@ template <int Dim, class Real>
 std::string device_step_unsupported(const SolverConfig<Dim, Real>& cfg) {
   if (cfg.time.mode == TimeStepping::PerParticle)
     return "per-particle time steps do not run on a device (time.stepping = fixed or courant)";
+  if (cfg.wall_model == WallModel::VolumeMap)
+    return "volume-map walls (boundary.model = volume-map) run on the CPU only for now";
   if (cfg.rigid_bodies.any() && !(cfg.rigid_bodies.contact_distance < double(cfg.support)))
     return "floating bodies on a device need body_contact.distance below the support h (the device's rows "
            "of body particles reach h)";
