@@ -121,6 +121,24 @@ CELLSPH_HD inline Vec<Dim, Real> volume_map_hydro(const VolumeMapProfile<Real>& 
   return n * (p.alpha * gn) + (g - n * gn) * p.beta;
 }
 
+// The 2^K corners of a multilinear interpolation in a grid of count[a] entries per axis (first fastest)
+// about the cell at `base` with fractions `frac`: f(index, weight) for each.
+template <int K, class Real, class F>
+CELLSPH_HD inline void volume_map_corners(const std::int32_t* base, const Real* frac,
+                                          const std::int32_t* count, const F& f) {
+  for (int c = 0; c < (1 << K); ++c) {
+    Real w = 1;
+    std::int64_t idx = 0, stride = 1;
+    for (int a = 0; a < K; ++a) {
+      const int bit = (c >> a) & 1;
+      w *= bit ? frac[a] : Real(1) - frac[a];
+      idx += stride * (base[a] + bit);
+      stride *= count[a];
+    }
+    f(idx, w);
+  }
+}
+
 // A table over [-reach, reach]^K (K = 2: two faces' overlap, 3: three), `count` entries per axis, first
 // index fastest, two values per entry (the overlap and its derivative in the first distance): both at d,
 // multilinearly.
@@ -136,18 +154,12 @@ CELLSPH_HD inline void volume_map_table(const Real* table, std::int32_t count, R
     frac[a] = t - Real(base[a]);
   }
   value = slope = 0;
-  for (int c = 0; c < (1 << K); ++c) {
-    Real w = 1;
-    std::int64_t idx = 0, stride = 1;
-    for (int a = 0; a < K; ++a) {
-      const int bit = (c >> a) & 1;
-      w *= bit ? frac[a] : Real(1) - frac[a];
-      idx += stride * (base[a] + bit);
-      stride *= count;
-    }
+  std::int32_t counts[K];
+  for (int a = 0; a < K; ++a) counts[a] = count;
+  volume_map_corners<K>(base, frac, counts, [&](std::int64_t idx, Real w) {
     value += w * table[2 * idx];
     slope += w * table[2 * idx + 1];
-  }
+  });
 }
 
 // The overlap of k faces (k = 1: the profile) at distances d[0..k) and its derivative in each.
@@ -239,18 +251,10 @@ CELLSPH_HD inline void volume_map_grid(const VolumeMapView<Dim, Real>& m, const 
     frac[a] = u - Real(k);
   }
   Real f[kF] = {};
-  for (int corner = 0; corner < (1 << Dim); ++corner) {
-    Real wgt = 1;
-    std::int64_t idx = 0, stride = 1;
-    for (int a = 0; a < Dim; ++a) {
-      const int bit = (corner >> a) & 1;
-      wgt *= bit ? frac[a] : Real(1) - frac[a];
-      idx += stride * (base[a] + bit);
-      stride *= m.n[a];
-    }
+  volume_map_corners<Dim>(base, frac, m.n, [&](std::int64_t idx, Real w) {
     const Real* node = m.nodes + idx * kF;
-    for (int k = 0; k < kF; ++k) f[k] += wgt * node[k];
-  }
+    for (int k = 0; k < kF; ++k) f[k] += w * node[k];
+  });
   if (!(f[0] < m.reach)) return;
   const auto p = volume_map_profile(m, f[0]);
   s.D += p.D;

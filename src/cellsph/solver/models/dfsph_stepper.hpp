@@ -39,6 +39,11 @@ inline std::string implicit_errors_summary(const DfsphStats& st, double bound) {
   return s;
 }
 
+// ", wall map M" of the summary's split: the volume-map walls' look-up a step (nothing without them).
+inline std::string wall_map_ms(const DfsphStats& st, double steps) {
+  return st.ms_walls > 0 ? ", wall map " + format_number("%.3g", st.ms_walls / steps) : std::string();
+}
+
 template <int Dim, class Real, class Ctx>
 class ImplicitPressureStepper : public ModelStepper<Dim, Real, Ctx> {
  public:
@@ -131,8 +136,7 @@ class DfsphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
     return {"dfsph: " + format_number("%.2f", sweeps / n) + " density + " +
                 format_number("%.2f", double(st.divergence_iterations) / n) + " divergence sweeps/step, " +
                 implicit_errors_summary(st, bound_),
-            "dfsph ms/step: search " + format_number("%.3g", search_ms / n) +
-                (st.ms_walls > 0 ? ", wall map " + format_number("%.3g", st.ms_walls / n) : std::string()) +
+            "dfsph ms/step: search " + format_number("%.3g", search_ms / n) + wall_map_ms(st, n) +
                 ", density+alpha " + format_number("%.3g", st.ms_factor / n) +
                 ", divergence solve + non-pressure forces " + format_number("%.3g", st.ms_divergence / n) +
                 ", kick " + format_number("%.3g", st.ms_nonpressure / n) + ", density solve " +

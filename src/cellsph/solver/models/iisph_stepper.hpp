@@ -28,8 +28,8 @@ class IisphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
     const double its = double(st.density_iterations);
     return {"iisph: " + format_number("%.2f", its / n) + " iterations/step, " +
                 implicit_errors_summary(st, bound_),
-            "iisph ms/step: search " + format_number("%.3g", search_ms / n) + ", density+alpha " +
-                format_number("%.3g", st.ms_factor / n) + ", non-pressure forces " +
+            "iisph ms/step: search " + format_number("%.3g", search_ms / n) + wall_map_ms(st, n) +
+                ", density+alpha " + format_number("%.3g", st.ms_factor / n) + ", non-pressure forces " +
                 format_number("%.3g", st.ms_nonpressure / n) + ", pressure solve " +
                 format_number("%.3g", st.ms_density / n) + ", drift " +
                 format_number("%.3g", st.ms_drift / n) + " (" +
