@@ -235,8 +235,12 @@ void validate_volume_map(const SolverConfig<Dim, Real>& c) {
   if (c.guard.moving())
     no("boundary.obstacles", "motion", "hold static solids only: a moving obstacle needs particle walls");
   if (c.rigid_bodies.any()) no("bodies", "floating", "do not move floating bodies yet");
-  if (!c.volume_map.empty() && !(c.volume_map.pitch > 0 && c.volume_map.reach > 0))
-    bad("volume_map.pitch", c.volume_map.pitch, "must be positive with a positive reach");
+  // A map built before (a config taken from a Simulation): its reach, and its grid's pitch where it has
+  // one (a tank alone has no grid).
+  if (!c.volume_map.empty() && !(c.volume_map.reach > 0))
+    bad("volume_map.reach", c.volume_map.reach, "must be positive");
+  if (!c.volume_map.nodes.empty() && !(c.volume_map.pitch > 0))
+    bad("volume_map.pitch", c.volume_map.pitch, "must be positive where the map has a grid");
 }
 
 template <int Dim, class Real>
