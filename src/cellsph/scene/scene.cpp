@@ -82,6 +82,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   s.warnings = geometry_warnings(regions, spacing, double(cfg.support));
   const FluidBlocks<Dim> fluids = read_fluids(r, spacing, files, phases, regions, budget, s.particles);
   if (auto d = default_stiffness(j, cfg, s.particles)) s.derived.push_back(std::move(*d));
+  if (auto d = default_column_step(j, spacing, cfg, s.particles)) s.derived.push_back(std::move(*d));
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);
   read_inflow(
       r, Dim, spacing, [&phases](JsonReader& e) { return phases.read_reference(e); }, cfg.inflow);

@@ -187,6 +187,13 @@ template <int Dim, class Real>
 std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverConfig<Dim, Real>& cfg,
                                                 const Particles<Dim, Real>& p);
 
+// /time/dt_column derived from the scene where it leaves it out, for DFSPH and IISPH with Courant steps
+// (sound_speed_default.cpp): 0.7 d / sqrt(g H), H as for the stiffness; says how.
+template <int Dim, class Real>
+std::optional<DerivedSetting> default_column_step(const nlohmann::json& j, double spacing,
+                                                  SolverConfig<Dim, Real>& cfg,
+                                                  const Particles<Dim, Real>& p);
+
 // Geometry the spacing resolves poorly (geometry_warnings.cpp): a gap narrower than two spacings between two
 // obstacles (boxes or shapes) or an obstacle and the tank's walls, an obstacle thinner than the kernel
 // support. One sentence each, naming the keys; nothing is changed.

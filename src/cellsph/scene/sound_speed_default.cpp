@@ -4,6 +4,10 @@
 // the fastest flow gravity makes there, so the Mach number stays near 0.1 and the density within about
 // 1% (Monaghan 1994; DualSPHysics derives its coefficient the same way). A fixed default cannot: 1000 Pa
 // is a speed of sound of 2.6 m/s for water, slower than a 1 m column falls.
+// And /time/dt_column for DFSPH and IISPH: 0.7 d / sqrt(g H) from the same H, the longest step at which a
+// resting column H deep settles (docs/physics.md, "The step limit of a resting column": measured c0 =
+// 0.70-0.79 at three depths and spacings), so a scene run at a finer spacing (or made deeper) does not keep
+// a dt_max chosen for a coarser one.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -65,16 +69,24 @@ FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Re
 
 }  // namespace
 
+// The gravity's size and the unit vector against it (zero without gravity).
+template <int Dim, class Real>
+double up_of(const SolverConfig<Dim, Real>& cfg, std::array<double, 3>& up) {
+  double g = 0;
+  for (int a = 0; a < Dim; ++a) g += double(cfg.gravity[a]) * double(cfg.gravity[a]);
+  g = std::sqrt(g);
+  up = {};
+  for (int a = 0; a < Dim; ++a) up[static_cast<std::size_t>(a)] = g > 0 ? -double(cfg.gravity[a]) / g : 0;
+  return g;
+}
+
 template <int Dim, class Real>
 std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverConfig<Dim, Real>& cfg,
                                                 const Particles<Dim, Real>& p) {
   if (stiffness_given(j) || implicit_pressure(cfg.model)) return std::nullopt;
   DerivedSetting d{"/solver/eos/stiffness", double(cfg.eos.stiffness), ""};
-  double g = 0;
-  for (int a = 0; a < Dim; ++a) g += double(cfg.gravity[a]) * double(cfg.gravity[a]);
-  g = std::sqrt(g);
   std::array<double, 3> up{};
-  for (int a = 0; a < Dim; ++a) up[static_cast<std::size_t>(a)] = g > 0 ? -double(cfg.gravity[a]) / g : 0;
+  const double g = up_of(cfg, up);
   const FluidDrop drop = fluid_drop(cfg, p, up);
   double rho0 = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
@@ -96,9 +108,36 @@ std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverC
   return d;
 }
 
+template <int Dim, class Real>
+std::optional<DerivedSetting> default_column_step(const nlohmann::json& j, double spacing,
+                                                  SolverConfig<Dim, Real>& cfg,
+                                                  const Particles<Dim, Real>& p) {
+  if (!implicit_pressure(cfg.model) || cfg.time.mode != TimeStepping::Courant ||
+      j.contains(nlohmann::json::json_pointer("/time/dt_column")))
+    return std::nullopt;
+  DerivedSetting d{"/time/dt_column", 0.0, ""};
+  std::array<double, 3> up{};
+  const double g = up_of(cfg, up);
+  const FluidDrop drop = fluid_drop(cfg, p, up);
+  const double height = drop.top - drop.lowest;
+  if (!(g > 0) || !(height > 0) || !std::isfinite(height)) {
+    d.why = std::string(!(g > 0) ? "no gravity" : "no fluid with a wall below it") +
+            " to derive it from: no bound beyond time.dt_max";
+    return d;
+  }
+  cfg.time.dt_column = static_cast<Real>(0.7 * spacing / std::sqrt(g * height));
+  d.value = double(cfg.time.dt_column);
+  d.why = "0.7 d / sqrt(g H), the longest step a resting column H = " + format_number("%.3g", height) +
+          " m deep holds at spacing d = " + format_number("%.3g", spacing) + " m" +
+          (cfg.time.dt_column < cfg.time.dt_max ? "; shorter than time.dt_max" : "; time.dt_max is shorter");
+  return d;
+}
+
 #define CELLSPH_SOUND_SPEED_INSTANTIATE(D, R)                                                                \
   template std::optional<DerivedSetting> default_stiffness<D, R>(const nlohmann::json&, SolverConfig<D, R>&, \
-                                                                 const Particles<D, R>&);
+                                                                 const Particles<D, R>&);                    \
+  template std::optional<DerivedSetting> default_column_step<D, R>(                                          \
+      const nlohmann::json&, double, SolverConfig<D, R>&, const Particles<D, R>&);
 CELLSPH_SOUND_SPEED_INSTANTIATE(2, float)
 CELLSPH_SOUND_SPEED_INSTANTIATE(2, double)
 CELLSPH_SOUND_SPEED_INSTANTIATE(3, float)

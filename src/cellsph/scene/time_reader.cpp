@@ -19,6 +19,7 @@ void read_time(JsonReader& r, SolverConfig<Dim, Real>& cfg, OutputSettings& out)
   cfg.time.correction = *parse_correction(tr.choice("correction", "exact", {"exact", "printed"}));
   cfg.time.dt = static_cast<Real>(tr.number("dt", double(cfg.time.dt), 1e-12, 10));
   cfg.time.dt_max = static_cast<Real>(tr.number("dt_max", double(cfg.time.dt_max), 1e-12, 10));
+  cfg.time.dt_column = static_cast<Real>(tr.number("dt_column", double(cfg.time.dt_column), 0, 10));
   cfg.time.courant = static_cast<Real>(tr.number("courant", double(cfg.time.courant), 1e-6, 2));
   cfg.time.viscous = static_cast<Real>(tr.number("viscous", double(cfg.time.viscous), 1e-6, 10));
   cfg.time.force = static_cast<Real>(tr.number("force", double(cfg.time.force), 1e-6, 10));

@@ -44,6 +44,7 @@ void validate_numbers(const SolverConfig<Dim, Real>& c) {
       bad("gravity[" + std::to_string(a) + "]", c.gravity[a], "must be finite");
   positive("time.dt", c.time.dt);
   positive("time.dt_max", c.time.dt_max);
+  non_negative("time.dt_column", c.time.dt_column);
   positive("time.courant", c.time.courant);
   positive("time.viscous", c.time.viscous);
   positive("time.force", c.time.force);

@@ -279,8 +279,11 @@ struct SolverConfig {
 
   struct Time {
     TimeStepping mode = TimeStepping::Fixed;
-    Real dt = Real(0.002);       // Fixed: the step [s]
-    Real dt_max = Real(0.01);    // Courant: upper bound of the step [s]
+    Real dt = Real(0.002);     // Fixed: the step [s]
+    Real dt_max = Real(0.01);  // Courant: upper bound of the step [s]
+    // DFSPH and IISPH with Courant steps: also at most this [s] (0: no such bound). Scenes derive it as
+    // 0.7 d / sqrt(g H), the longest step a resting column H deep holds (scene/sound_speed_default.cpp).
+    Real dt_column = Real(0);
     Real courant = Real(0.3);    // alpha of eq. 12
     Real viscous = Real(0.125);  // dt <= viscous * h^2 rho0 / mu
     Real force = Real(0.25);     // dt <= force * sqrt(h / |a|max)

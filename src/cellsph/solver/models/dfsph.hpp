@@ -552,7 +552,8 @@ Real dfsph_particle_diameter(const ParticleView<Dim, Real>& pv, const IndexSet& 
 }
 
 // Step 2 (DFSPH and IISPH): the step from the velocities at its start: time.dt when the stepping is fixed,
-// else min(dt_max, courant * d / max |v|, viscous * d^2 / max nu).
+// else min(dt_max, dt_column, courant * d / max |v|, viscous * d^2 / max nu) (dt_column where set: the
+// longest step a resting column of the scene's height holds, docs/physics.md "Model 3").
 template <int Dim, class Real, class Set>
 Real implicit_step_size(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv,
                         const Set& fluid, Real diameter) {
@@ -560,6 +561,7 @@ Real implicit_step_size(const SolverConfig<Dim, Real>& cfg, const ParticleView<D
   Real nu_max = 0;
   for (const auto& ph : cfg.phases) nu_max = std::max(nu_max, ph.viscosity / ph.rest_density);
   Real dt = cfg.time.dt_max;
+  if (cfg.time.dt_column > 0) dt = std::min(dt, cfg.time.dt_column);
   const auto mx = reduce_max(fluid, CourantMaxima<Real>{}, CourantLimitsPass<Dim, Real>{pv, false});
   if (mx.v2 > 0) dt = std::min(dt, cfg.time.courant * diameter / std::sqrt(mx.v2));
   // Explicit viscosity: the limit on the particle spacing, not the support (measured: on h = 2 d the
