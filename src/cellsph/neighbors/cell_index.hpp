@@ -928,6 +928,9 @@ class CellIndex {
   // Kept: masks is where p's hit masks go (Write: ceil(n / 64) words) or are (Read); null with None.
   // Blocks of at most kStoreMax candidates keep them in work_ (kStoreWords words a particle),
   // longer ones in their chunk's spill. A Read traversal copies no positions.
+  // The steps of a home cell are named below (visit_zero_cell, find_mask_cells, gather_home, own_support),
+  // always inlined, with the chunk's state passed as locals: kept in a struct instead, the search was 40%
+  // slower at subdivision 2 (BM_CellIndexBuildAndLists/H:2).
   template <bool WithIds, bool ById = false, Masks Kept = Masks::None, class Kernel>
   std::uint64_t traverse(Kernel&& kernel) const {
     const std::size_t nc = cell_count();
@@ -960,40 +963,11 @@ class CellIndex {
             static_cast<std::uint32_t>(std::lower_bound(cells, cells + nc, cells[u0] + deltas_[m]) - cells);
       std::uint64_t local_tests = 0;
       for (std::size_t u = u0; u < u1; ++u) {
-        if (zero_cell_[u] && !zero_rows_) {
-          for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) kernel(p, Block{}, masks(p, 0));
-          continue;  // the cursors catch up at the next cell, as below
-        }
         if (zero_cell_[u]) {
-          // Support 0: the neighbours are the points at distance 0, which share the home cell (a
-          // cell is a function of the position). The cursors skip this cell; the next cell's
-          // update catches them up.
-          const Range home_only{start[u], start[u + 1], 0};
-          const std::uint32_t len = home_only.end - home_only.begin;
-          for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
-            local_tests += len - 1;
-            Block blk = own_buf.fill(*this, &home_only, 1, len, with_x, WithIds);
-            blk.self0 = 0;
-            blk.p0 = start[u];
-            kernel(p, blk, masks(p, len));
-          }
-          continue;
+          local_tests += visit_zero_cell<WithIds, with_x>(u, kernel, masks, own_buf);
+          continue;  // the cursors catch up at the next cell
         }
-        const std::uint64_t home = cells[u];
-        int nf = 0;
-        for (std::size_t m = 0; m < M; ++m) {
-          const std::uint64_t t = home + deltas_[m];
-          std::uint32_t c = cur[m];
-          // A cursor mostly moves 0 or 1 cell per home cell: two branch-free steps, then a loop
-          // that runs only after a gap in the occupied cells.
-          c += cells[c] < t ? 1u : 0u;
-          c += cells[c] < t ? 1u : 0u;
-          while (cells[c] < t) ++c;
-          cur[m] = c;
-          // Visit only an exact match; the sentinel (c == nc) never is one. Written branch free.
-          found[static_cast<std::size_t>(nf)] = {start[c], start[c + (c < nc ? 1 : 0)], mask_[m].gap2};
-          nf += (cells[c] == t && c < nc) ? 1 : 0;
-        }
+        const int nf = find_mask_cells(cells[u], cur.data(), found.data());
         // Mask cells found in consecutive sorted cells (neighbours along axis 0) are one range.
         const int nm = merge(found.data(), nf, merged.data());
         std::uint32_t total = 0;
@@ -1004,54 +978,118 @@ class CellIndex {
         for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
           if (uniform_h_ || hs_[p] == hmax_) {
             // Full support: the whole mask, shared by every such particle of the home cell.
-            if (!gathered) {
-              // A block sorted by id needs its ids, whether or not the kernel reads them. The fill
-              // pass gathers them again and takes back from the count pass's spill where each came
-              // from (16 bits a candidate, so blocks up to 2^16), instead of sorting again.
-              const bool by_id = ById && total >= kSortBlockMin;
-              const bool kept_order = by_id && total <= kept_order_max_;
-              const std::size_t order_words = (std::size_t{total} + 3) / 4;
-              home_blk = home_buf.fill(*this, merged.data(), nm, total, with_x, WithIds || by_id);
-              home_blk.self0 = block_pos(merged.data(), nm, start[u]);
-              home_blk.p0 = start[u];
-              if (Kept == Masks::Read && kept_order) {
-                home_buf.permute_ids(home_blk, spill->template take<false>(order_words));
-              } else if (by_id) {
-                home_buf.sort_by_id(home_blk, start[u + 1] - start[u], with_x);
-                if (Kept == Masks::Write && kept_order)
-                  home_buf.save_order(spill->template take<true>(order_words), total);
-              }
-            }
+            if (!gathered)
+              home_blk =
+                  gather_home<WithIds, ById, Kept, with_x>(u, merged.data(), nm, total, home_buf, spill);
             gathered = true;
             local_tests += total - 1;
             kernel(p, home_blk, masks(p, total));
           } else if (!zero_rows_ && hs_[p] == 0) {
             kernel(p, Block{}, masks(p, 0));  // an empty row, not searched (zero_support_rows)
           } else {
-            // Smaller support: only the mask cells that can reach within h_p (section 4.1).
-            const double reach = double(hs_[p]) / cell_size_;
-            int nk = 0;
-            std::uint32_t mt = 0;
-            for (int s = 0; s < nf; ++s) {
-              const Range& r = found[static_cast<std::size_t>(s)];
-              if (!mask_keeps(r.gap2, reach)) continue;
-              if (nk > 0 && mine[static_cast<std::size_t>(nk - 1)].end == r.begin)
-                mine[static_cast<std::size_t>(nk - 1)].end = r.end;
-              else
-                mine[static_cast<std::size_t>(nk++)] = r;
-              mt += r.end - r.begin;
-            }
-            local_tests += mt - 1;
-            Block blk = own_buf.fill(*this, mine.data(), nk, mt, with_x, WithIds);
-            blk.self0 = block_pos(mine.data(), nk, start[u]);
-            blk.p0 = start[u];
-            kernel(p, blk, masks(p, mt));
+            local_tests +=
+                own_support<WithIds, with_x>(p, u, found.data(), nf, mine.data(), own_buf, kernel, masks);
           }
         }
       }
       tests.fetch_add(local_tests, std::memory_order_relaxed);
     });
     return tests.load();
+  }
+
+  // Home cell u of traverse whose particles all have support 0; returns the distance tests. Without
+  // zero_rows_ each gets an empty row; with them its neighbours are the points at distance 0, which share
+  // the home cell (a cell is a function of the position).
+  template <bool WithIds, bool WithX, class Kernel, class MaskFn>
+  [[gnu::always_inline]] std::uint64_t visit_zero_cell(std::size_t u, Kernel& kernel, MaskFn& masks,
+                                                       BlockBuffer& buf) const {
+    const std::uint32_t* start = cell_start_.data();
+    if (!zero_rows_) {
+      for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) kernel(p, Block{}, masks(p, 0));
+      return 0;
+    }
+    const Range home_only{start[u], start[u + 1], 0};
+    const std::uint32_t len = home_only.end - home_only.begin;
+    std::uint64_t tests = 0;
+    for (std::uint32_t p = start[u]; p < start[u + 1]; ++p) {
+      tests += len - 1;
+      Block blk = buf.fill(*this, &home_only, 1, len, WithX, WithIds);
+      blk.self0 = 0;
+      blk.p0 = start[u];
+      kernel(p, blk, masks(p, len));
+    }
+    return tests;
+  }
+
+  // Moves traverse's cursors `cur` (one per mask cell) to the mask cells of home cell `home` and puts the
+  // occupied ones in `found`; returns how many there are.
+  [[gnu::always_inline]] int find_mask_cells(std::uint64_t home, std::uint32_t* cur, Range* found) const {
+    const std::uint64_t* cells = cells_.data();
+    const std::uint32_t* start = cell_start_.data();
+    const std::size_t nc = cell_count(), M = mask_.size();
+    int nf = 0;
+    for (std::size_t m = 0; m < M; ++m) {
+      const std::uint64_t t = home + deltas_[m];
+      std::uint32_t c = cur[m];
+      // A cursor mostly moves 0 or 1 cell per home cell: two branch-free steps, then a loop
+      // that runs only after a gap in the occupied cells.
+      c += cells[c] < t ? 1u : 0u;
+      c += cells[c] < t ? 1u : 0u;
+      while (cells[c] < t) ++c;
+      cur[m] = c;
+      // Visit only an exact match; the sentinel (c == nc) never is one. Written branch free.
+      found[nf] = {start[c], start[c + (c < nc ? 1 : 0)], mask_[m].gap2};
+      nf += (cells[c] == t && c < nc) ? 1 : 0;
+    }
+    return nf;
+  }
+
+  // The full support's block of home cell u: the nm ranges `merged`, `total` candidates. A block sorted by
+  // id needs its ids, whether or not the kernel reads them. The fill pass gathers them again and takes back
+  // from the count pass's spill where each came from (16 bits a candidate, so blocks up to 2^16), instead
+  // of sorting again.
+  template <bool WithIds, bool ById, Masks Kept, bool WithX>
+  [[gnu::always_inline]] Block gather_home(std::size_t u, const Range* merged, int nm, std::uint32_t total,
+                                           BlockBuffer& buf, Spill* spill) const {
+    const std::uint32_t* start = cell_start_.data();
+    const bool by_id = ById && total >= kSortBlockMin;
+    const bool kept_order = by_id && total <= kept_order_max_;
+    const std::size_t order_words = (std::size_t{total} + 3) / 4;
+    Block blk = buf.fill(*this, merged, nm, total, WithX, WithIds || by_id);
+    blk.self0 = block_pos(merged, nm, start[u]);
+    blk.p0 = start[u];
+    if (Kept == Masks::Read && kept_order) {
+      buf.permute_ids(blk, spill->template take<false>(order_words));
+    } else if (by_id) {
+      buf.sort_by_id(blk, start[u + 1] - start[u], WithX);
+      if (Kept == Masks::Write && kept_order) buf.save_order(spill->template take<true>(order_words), total);
+    }
+    return blk;
+  }
+
+  // Particle p of home cell u with a smaller support (section 4.1): only the nf mask cells `found` that can
+  // reach within h_p, gathered into `mine`; returns the distance tests.
+  template <bool WithIds, bool WithX, class Kernel, class MaskFn>
+  [[gnu::always_inline]] std::uint64_t own_support(std::uint32_t p, std::size_t u, const Range* found, int nf,
+                                                   Range* mine, BlockBuffer& buf, Kernel& kernel,
+                                                   MaskFn& masks) const {
+    const double reach = double(hs_[p]) / cell_size_;
+    int nk = 0;
+    std::uint32_t mt = 0;
+    for (int s = 0; s < nf; ++s) {
+      const Range& r = found[s];
+      if (!mask_keeps(r.gap2, reach)) continue;
+      if (nk > 0 && mine[nk - 1].end == r.begin)
+        mine[nk - 1].end = r.end;
+      else
+        mine[nk++] = r;
+      mt += r.end - r.begin;
+    }
+    Block blk = buf.fill(*this, mine, nk, mt, WithX, WithIds);
+    blk.self0 = block_pos(mine, nk, cell_start_[u]);
+    blk.p0 = cell_start_[u];
+    kernel(p, blk, masks(p, mt));
+    return std::uint64_t{mt - 1};
   }
 
   static int merge(const Range* in, int n, Range* out) {
