@@ -18,6 +18,12 @@ void write_vtu(const Particles<Dim, Real>& particles, double time, const std::fi
   write_vtu_any(particles, time, path);
 }
 
+template <int Dim, class Real>
+void write_pvtu(const Particles<Dim, Real>& like, const std::vector<std::string>& pieces,
+                const std::filesystem::path& path) {
+  write_pvtu_any(like, pieces, path);
+}
+
 PvdWriter::PvdWriter(std::filesystem::path path, std::vector<PvdEntry> entries)
     : path_(std::move(path)), entries_(std::move(entries)) {}
 
@@ -94,5 +100,13 @@ template void write_vtu<2, float>(const Particles<2, float>&, double, const std:
 template void write_vtu<2, double>(const Particles<2, double>&, double, const std::filesystem::path&);
 template void write_vtu<3, float>(const Particles<3, float>&, double, const std::filesystem::path&);
 template void write_vtu<3, double>(const Particles<3, double>&, double, const std::filesystem::path&);
+template void write_pvtu<2, float>(const Particles<2, float>&, const std::vector<std::string>&,
+                                   const std::filesystem::path&);
+template void write_pvtu<2, double>(const Particles<2, double>&, const std::vector<std::string>&,
+                                    const std::filesystem::path&);
+template void write_pvtu<3, float>(const Particles<3, float>&, const std::vector<std::string>&,
+                                   const std::filesystem::path&);
+template void write_pvtu<3, double>(const Particles<3, double>&, const std::vector<std::string>&,
+                                    const std::filesystem::path&);
 
 }  // namespace cellsph

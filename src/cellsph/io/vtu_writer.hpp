@@ -15,6 +15,14 @@ namespace cellsph {
 template <int Dim, class Real>
 void write_vtu(const Particles<Dim, Real>& particles, double time, const std::filesystem::path& path);
 
+// A frame written in pieces, one .vtu each (a run over several processes: one per rank), opens in ParaView
+// as one data set through its .pvtu (PUnstructuredGrid): this writes it, atomically, listing `pieces`
+// (file names relative to the .pvtu's folder) with the arrays of Particles<Dim, Real>; `like` gives their
+// names and types (any particle set of the run: its values are not read).
+template <int Dim, class Real>
+void write_pvtu(const Particles<Dim, Real>& like, const std::vector<std::string>& pieces,
+                const std::filesystem::path& path);
+
 struct PvdEntry {
   double time = 0;
   std::string file;  // relative to the .pvd's folder

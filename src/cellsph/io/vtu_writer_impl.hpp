@@ -171,4 +171,39 @@ void write_vtu_any(const P& particles, double time, const std::filesystem::path&
   file.commit();
 }
 
+// The .pvtu of one frame written as pieces (write_vtu_any, one file each): the arrays' names, types and
+// components as `like` has them (its values are not read), then each piece's file. VTK's reader requires
+// every piece to hold exactly the arrays declared here.
+template <class P>
+void write_pvtu_any(const P& like, const std::vector<std::string>& pieces,
+                    const std::filesystem::path& path) {
+  using namespace io::detail;
+  auto declare = [](std::string& xml, std::string_view name, const auto& field) {
+    using FT = io::FieldOf<std::remove_cvref_t<decltype(field)>>;
+    xml += "      <PDataArray type=\"";
+    xml += io::vtk_type_name<typename FT::Scalar>();
+    xml += "\" Name=\"";
+    xml += name;
+    xml += "\" NumberOfComponents=\"" + std::to_string(vtk_components<FT>()) + "\"/>\n";
+  };
+  std::string xml;
+  xml += "<?xml version=\"1.0\"?>\n";
+  xml +=
+      "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n";
+  xml += "  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  xml += "    <PPointData>\n";
+  like.for_each_field([&](std::string_view name, const auto& field) {
+    if (name != "position") declare(xml, name, field);
+  });
+  xml += "    </PPointData>\n";
+  xml += "    <PPoints>\n";
+  declare(xml, "position", like.x);
+  xml += "    </PPoints>\n";
+  for (const auto& piece : pieces) xml += "    <Piece Source=\"" + xml_escape(piece) + "\"/>\n";
+  xml += "  </PUnstructuredGrid>\n";
+  xml += "</VTKFile>\n";
+  write_file_atomic(path, xml);
+}
+
 }  // namespace cellsph

@@ -2,11 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <map>
 #include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/io/io_test_util.hpp"
@@ -256,6 +260,62 @@ TEST(VtuWriter, ReadBackByVtkWhenInstalled) {
   EXPECT_EQ(rho, widened(p.rho[4]));
   EXPECT_EQ(phase, p.phase[4]);
   EXPECT_EQ(comps, 3);
+}
+
+// A frame in three pieces (one empty, as a rank may hold no particle) opens through its .pvtu in VTK's own
+// reader as the whole set: every point, in piece order, with its values.
+TEST(PvtuWriter, PiecesReadBackByVtkAsTheWholeSet) {
+  if (std::system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-vtk9 is not installed (scripts/setup.sh --test installs it)";
+  test::TempDir dir("pvtu_vtk");
+  const auto whole = test::make_particles<3, double>(7);
+  std::vector<std::string> names;
+  const std::size_t cuts[] = {0, 4, 4, 7};
+  for (int k = 0; k < 3; ++k) {
+    Particles<3, double> piece;
+    piece.resize(cuts[k + 1] - cuts[k]);
+    piece.for_each_field([&](std::string_view name, auto& field) {
+      whole.for_each_field([&](std::string_view n2, const auto& f2) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(field)>, std::decay_t<decltype(f2)>>) {
+          if (name == n2)
+            std::copy(f2.begin() + long(cuts[k]), f2.begin() + long(cuts[k + 1]), field.begin());
+        }
+      });
+    });
+    names.push_back("f_" + std::to_string(k) + ".vtu");
+    write_vtu(piece, 0.5, dir / names.back());
+  }
+  write_pvtu(whole, names, dir / "f.pvtu");
+  test::spit(dir / "read.py",
+             "import sys, vtk\n"
+             "r = vtk.vtkXMLPUnstructuredGridReader()\n"
+             "r.SetFileName(sys.argv[1])\n"
+             "r.Update()\n"
+             "g = r.GetOutput()\n"
+             "pd = g.GetPointData()\n"
+             "print(g.GetNumberOfPoints(), pd.GetNumberOfArrays())\n"
+             "for i in range(g.GetNumberOfPoints()):\n"
+             "    print(repr(g.GetPoint(i)[0]), repr(pd.GetArray('density').GetValue(i)), "
+             "pd.GetArray('id').GetValue(i))\n");
+  const auto out = dir / "out.txt";
+  const std::string cmd = "/usr/bin/python3 " + (dir / "read.py").string() + " " + (dir / "f.pvtu").string() +
+                          " > " + out.string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::slurp(out);
+  std::istringstream lines(test::slurp(out));
+  std::size_t points = 0, arrays = 0;
+  lines >> points >> arrays;
+  EXPECT_EQ(points, whole.size());
+  std::size_t fields = 0;
+  whole.for_each_field([&](std::string_view, const auto&) { ++fields; });
+  EXPECT_EQ(arrays, fields - 1);  // position is the Points
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    double x = 0, rho = 0;
+    long long id = -1;
+    lines >> x >> rho >> id;
+    EXPECT_EQ(x, whole.x[i][0]) << "point " << i;
+    EXPECT_EQ(rho, whole.rho[i]) << "point " << i;
+    EXPECT_EQ(id, static_cast<long long>(whole.id[i])) << "point " << i;
+  }
 }
 
 TEST(PvdWriter, ListsEveryFrameWithItsTimeAfterEachAdd) {
