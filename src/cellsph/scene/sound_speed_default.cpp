@@ -24,12 +24,22 @@ bool stiffness_given(const nlohmann::json& j) {
   return j.contains(nlohmann::json::json_pointer("/solver/eos/stiffness"));
 }
 
-// The fluid's top and the lowest wall under it (a wall particle, the write-up's box, an up-facing plane
-// of the paper's), as heights along `up`; lowest = +inf without a wall.
+// The fluid's top and the lowest wall under it (a wall particle, the write-up's box, the tank of
+// boundary.walls, an up-facing plane of the paper's), as heights along `up`; lowest = +inf without a wall.
 struct FluidDrop {
   double top = -std::numeric_limits<double>::infinity();
   double lowest = std::numeric_limits<double>::infinity();
 };
+
+// The lowest point of the box [lo, hi] along `up`.
+template <int Dim, class Real>
+double box_floor(const Vec<Dim, Real>& lo, const Vec<Dim, Real>& hi, const std::array<double, 3>& up) {
+  double floor = 0;
+  for (int a = 0; a < Dim; ++a)
+    floor += std::min(up[static_cast<std::size_t>(a)] * double(lo[a]),
+                      up[static_cast<std::size_t>(a)] * double(hi[a]));
+  return floor;
+}
 
 template <int Dim, class Real>
 FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p,
@@ -40,13 +50,10 @@ FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Re
     return h;
   };
   FluidDrop d;
-  if (cfg.box.enabled) {  // the write-up's box: its lowest corner
-    double floor = 0;
-    for (int a = 0; a < Dim; ++a)
-      floor += std::min(up[static_cast<std::size_t>(a)] * double(cfg.box.lo[a]),
-                        up[static_cast<std::size_t>(a)] * double(cfg.box.hi[a]));
-    d.lowest = floor;
-  }
+  if (cfg.box.enabled) d.lowest = box_floor(cfg.box.lo, cfg.box.hi, up);  // the write-up's box
+  // The tank's floor: with volume-map walls the only sign of it (its wall particles, where it has them,
+  // lie below it).
+  if (cfg.guard.container) d.lowest = std::min(d.lowest, box_floor(cfg.guard.lo, cfg.guard.hi, up));
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double h = height(p.x[i]);
     if (p.kind[i] == std::uint8_t(ParticleKind::Boundary)) {
@@ -67,8 +74,6 @@ FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Re
   return d;
 }
 
-}  // namespace
-
 // The gravity's size and the unit vector against it (zero without gravity).
 template <int Dim, class Real>
 double up_of(const SolverConfig<Dim, Real>& cfg, std::array<double, 3>& up) {
@@ -79,6 +84,8 @@ double up_of(const SolverConfig<Dim, Real>& cfg, std::array<double, 3>& up) {
   for (int a = 0; a < Dim; ++a) up[static_cast<std::size_t>(a)] = g > 0 ? -double(cfg.gravity[a]) / g : 0;
   return g;
 }
+
+}  // namespace
 
 template <int Dim, class Real>
 std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverConfig<Dim, Real>& cfg,

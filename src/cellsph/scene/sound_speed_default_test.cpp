@@ -124,6 +124,23 @@ TEST(ColumnStepDefault, DfsphAndIisphScenesGetItFromTheFluidsHeight) {
   }
 }
 
+// Volume-map walls make no wall particles: the lowest wall is the tank's floor y = 0 itself (the guard's
+// tank), so H = 2 - d/2 from the top row. Without it no bound was derived for such a scene.
+TEST(ColumnStepDefault, VolumeMapWallsTakeTheTanksFloor) {
+  for (const double f : {1.0, 0.5}) {
+    SCOPED_TRACE(std::to_string(f) + " x the spacing");
+    auto j = dfsph_dam_break(f);
+    j["boundary"]["model"] = "volume-map";
+    const double d = 0.02 * f, H = 2 - d / 2, expected = 0.7 * d / std::sqrt(9.81 * H);
+    const auto s = load_scene<2, double>(j, "dam.json");
+    EXPECT_EQ(s.particles.size(), std::size_t(std::lround(2 / (d * d))));  // fluid only
+    EXPECT_NEAR(s.solver.time.dt_column, expected, 1e-12 * expected);
+    const DerivedSetting* said = derived(s, "/time/dt_column");
+    ASSERT_NE(said, nullptr);
+    EXPECT_EQ(said->value, s.solver.time.dt_column);
+  }
+}
+
 // A scene's own dt_column is kept (0: no bound), fixed steps and the explicit models get none.
 TEST(ColumnStepDefault, GivenFixedStepsAndExplicitModelsKeepTheirs) {
   auto given = dfsph_dam_break(1);
