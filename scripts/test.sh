@@ -41,10 +41,12 @@ cmake --build build/asan -j "$JOBS"
 # Also every built-in scene at twice its spacing to its end (SceneAnySpacing, issue 52 item 3: about 100
 # release test-seconds), whose code the stability runs above take under the sanitizers; and
 # dam-break-2d-dfsph at half its spacing for 0.2 s (ColumnStepDefault.DamBreakAtHalfItsSpacing...: 7
-# release test-seconds), whose derived step the short tests beside it check under the sanitizers.
+# release test-seconds), whose derived step the short tests beside it check under the sanitizers; and the
+# paper's three dam breaks at once and twice their spacing to 1 s (SceneAnySpacingPhysics: about 25 release
+# test-seconds), whose model the stability runs of the 2D paper scenes take under the sanitizers.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp \
-  ctest --test-dir build/asan -j "$JOBS" --output-on-failure -E '^((Lobovsky2014|SphericTest2|DamBreakResidual)\.|Builtin/SceneStability\..*/(paper_dam_break_[123]|dam_break_3d|spheric_test2)|Builtin/SceneAnySpacing\.|ColumnStepDefault\.DamBreakAtHalf|Walls\.NoSlipMatchesStokesFirstProblem|MovingWalls\.SlidingFloorDragsTheFluidAsStokesFirstProblem|DensityDiffusion\.RestingTankPressureAgainstHydrostatic|SceneShapes\.ContainerMesh(HoldsStillWaterForTenThousandSteps|HydrostaticPressureWithinTwoPercent)|RigidBodies\.ArchimedesHalfSubmergedAtDensity500)'
+  ctest --test-dir build/asan -j "$JOBS" --output-on-failure -E '^((Lobovsky2014|SphericTest2|DamBreakResidual)\.|Builtin/SceneStability\..*/(paper_dam_break_[123]|dam_break_3d|spheric_test2)|Builtin/SceneAnySpacing\.|SceneAnySpacingPhysics\.|ColumnStepDefault\.DamBreakAtHalf|Walls\.NoSlipMatchesStokesFirstProblem|MovingWalls\.SlidingFloorDragsTheFluidAsStokesFirstProblem|DensityDiffusion\.RestingTankPressureAgainstHydrostatic|SceneShapes\.ContainerMesh(HoldsStillWaterForTenThousandSteps|HydrostaticPressureWithinTwoPercent)|RigidBodies\.ArchimedesHalfSubmergedAtDensity500)'
 
 # One fixed seed (FUZZ_SEED, default 1): the same commit fuzzes the same inputs here and in CI, so a
 # clean run here predicts CI's. Finding new failures is the longer runs' job (docs/fuzzing.md).

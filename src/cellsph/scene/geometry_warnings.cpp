@@ -1,7 +1,8 @@
 // Geometry the particle spacing resolves poorly, said when the scene loads (issue 52 item 5): a gap
 // under two spacings holds at most one row of fluid particles, which the kernel sees as a film; a solid
 // thinner than the kernel support gives the fluid beside it fewer wall neighbours than a wall of full
-// depth, so its pressure pushes back too weakly. Box obstacles and the tank's box walls are checked
+// depth, so its pressure pushes back too weakly; a fluid block thinner than the support has no particle
+// whose kernel lies inside it. Box obstacles and the tank's box walls are checked
 // exactly; shaped obstacles (meshes, spheres, cylinders) are not.
 #include <cstdio>
 
@@ -230,7 +231,26 @@ std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double s
   return out;
 }
 
+template <int Dim>
+std::vector<std::string> fluid_block_warnings(const FluidBlocks<Dim>& fluids, double support) {
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < fluids.blocks.size(); ++k)
+    for (std::size_t a = 0; a < Dim; ++a) {
+      const double t = fluids.blocks[k].hi[a] - fluids.blocks[k].lo[a];
+      if (t < support)
+        out.push_back("/fluids/" + std::to_string(k) + ": " + metres(t) + " thick along " + kAxis[a] +
+                      ", less than the kernel support " + metres(support) +
+                      ": every particle's kernel spans the block, which then holds no interior to keep its "
+                      "density (a free block this thin collapses); a finer /spacing with a smaller "
+                      "/solver/support resolves it");
+    }
+  return out;
+}
+
 template std::vector<std::string> geometry_warnings<2>(const Regions<2>&, double, double);
 template std::vector<std::string> geometry_warnings<3>(const Regions<3>&, double, double);
+
+template std::vector<std::string> fluid_block_warnings<2>(const FluidBlocks<2>&, double);
+template std::vector<std::string> fluid_block_warnings<3>(const FluidBlocks<3>&, double);
 
 }  // namespace cellsph::scene_detail

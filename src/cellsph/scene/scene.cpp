@@ -81,6 +81,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   read_domain(r, cfg, regions);
   s.warnings = geometry_warnings(regions, spacing, double(cfg.support));
   const FluidBlocks<Dim> fluids = read_fluids(r, spacing, files, phases, regions, budget, s.particles);
+  for (auto& w : fluid_block_warnings(fluids, double(cfg.support))) s.warnings.push_back(std::move(w));
   if (auto d = default_stiffness(j, cfg, s.particles)) s.derived.push_back(std::move(*d));
   if (auto d = default_column_step(j, spacing, cfg, s.particles)) s.derived.push_back(std::move(*d));
   read_initial_pressure(r, spacing, cfg, phases, fluids, s.particles);

@@ -199,6 +199,9 @@ std::optional<DerivedSetting> default_column_step(const nlohmann::json& j, doubl
 // support. One sentence each, naming the keys; nothing is changed.
 template <int Dim>
 std::vector<std::string> geometry_warnings(const Regions<Dim>& regions, double spacing, double support);
+// Fluid blocks thinner than the kernel support along some axis (geometry_warnings.cpp): one sentence each.
+template <int Dim>
+std::vector<std::string> fluid_block_warnings(const FluidBlocks<Dim>& fluids, double support);
 
 // How deep inside a wall or obstacle a fluid particle may end a step, and how far on the fluid side of
 // its surface it is put back, in spacings (solver/boundary/solid_guard.hpp): the first layer of wall
