@@ -42,7 +42,7 @@ cmake --build build/asan -j "$JOBS"
 # release test-seconds), whose code the stability runs above take under the sanitizers; and
 # dam-break-2d-dfsph at half its spacing for 0.2 s (ColumnStepDefault.DamBreakAtHalfItsSpacing...: 7
 # release test-seconds), whose derived step the short tests beside it check under the sanitizers; and the
-# paper's three dam breaks at once and twice their spacing to 1 s (SceneAnySpacingPhysics: about 25 release
+# paper's three dam breaks at once and twice their spacing to 1 s (SceneAnySpacingPhysics: about 16 release
 # test-seconds), whose model the stability runs of the 2D paper scenes take under the sanitizers.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp \
