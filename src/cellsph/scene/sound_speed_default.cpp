@@ -74,15 +74,21 @@ FluidDrop fluid_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Re
   return d;
 }
 
-// The gravity's size and the unit vector against it (zero without gravity).
+// What both defaults start from: the gravity's size and the drop H from the fluid's top to the lowest wall
+// under it, measured against gravity (not finite without fluid or without a wall under it).
+struct GravityDrop {
+  double g = 0, height = 0;
+};
+
 template <int Dim, class Real>
-double up_of(const SolverConfig<Dim, Real>& cfg, std::array<double, 3>& up) {
+GravityDrop gravity_drop(const SolverConfig<Dim, Real>& cfg, const Particles<Dim, Real>& p) {
   double g = 0;
   for (int a = 0; a < Dim; ++a) g += double(cfg.gravity[a]) * double(cfg.gravity[a]);
   g = std::sqrt(g);
-  up = {};
+  std::array<double, 3> up{};
   for (int a = 0; a < Dim; ++a) up[static_cast<std::size_t>(a)] = g > 0 ? -double(cfg.gravity[a]) / g : 0;
-  return g;
+  const FluidDrop drop = fluid_drop(cfg, p, up);
+  return {g, drop.top - drop.lowest};
 }
 
 }  // namespace
@@ -92,14 +98,11 @@ std::optional<DerivedSetting> default_stiffness(const nlohmann::json& j, SolverC
                                                 const Particles<Dim, Real>& p) {
   if (stiffness_given(j) || implicit_pressure(cfg.model)) return std::nullopt;
   DerivedSetting d{"/solver/eos/stiffness", double(cfg.eos.stiffness), ""};
-  std::array<double, 3> up{};
-  const double g = up_of(cfg, up);
-  const FluidDrop drop = fluid_drop(cfg, p, up);
+  const auto [g, height] = gravity_drop(cfg, p);
   double rho0 = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
     if (p.kind[i] == std::uint8_t(ParticleKind::Fluid))
       rho0 = std::max(rho0, double(cfg.phases[static_cast<std::size_t>(p.phase[i])].rest_density));
-  const double height = drop.top - drop.lowest;
   if (!(g > 0) || !(rho0 > 0) || !(height > 0) || !std::isfinite(height)) {
     d.why = std::string(!(g > 0)    ? "no gravity"
                         : rho0 <= 0 ? "no fluid at the start"
@@ -123,10 +126,7 @@ std::optional<DerivedSetting> default_column_step(const nlohmann::json& j, doubl
       j.contains(nlohmann::json::json_pointer("/time/dt_column")))
     return std::nullopt;
   DerivedSetting d{"/time/dt_column", 0.0, ""};
-  std::array<double, 3> up{};
-  const double g = up_of(cfg, up);
-  const FluidDrop drop = fluid_drop(cfg, p, up);
-  const double height = drop.top - drop.lowest;
+  const auto [g, height] = gravity_drop(cfg, p);
   if (!(g > 0) || !(height > 0) || !std::isfinite(height)) {
     d.why = std::string(!(g > 0) ? "no gravity" : "no fluid with a wall below it") +
             " to derive it from: no bound beyond time.dt_max";
