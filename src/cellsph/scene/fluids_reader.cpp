@@ -251,8 +251,10 @@ FluidBlocks<Dim> read_fluids(JsonReader& r, double spacing, const MeshFiles& fil
     if (!e.json().is_object()) e.fail_here("expected an object, got " + json_value_text(e.json()));
     if (auto shape = read_shape<Dim>(e, spacing, files))
       add_fluid_volume(e, k, *shape, target);
-    else
+    else {
       add_fluid_block(e, target);
+      out.key.push_back(k);
+    }
   }
   return out;
 }

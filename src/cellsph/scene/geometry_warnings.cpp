@@ -238,8 +238,8 @@ std::vector<std::string> fluid_block_warnings(const FluidBlocks<Dim>& fluids, do
     for (std::size_t a = 0; a < Dim; ++a) {
       const double t = fluids.blocks[k].hi[a] - fluids.blocks[k].lo[a];
       if (t < support)
-        out.push_back("/fluids/" + std::to_string(k) + ": " + metres(t) + " thick along " + kAxis[a] +
-                      ", less than the kernel support " + metres(support) +
+        out.push_back("/fluids/" + std::to_string(fluids.key[k]) + ": " + metres(t) + " thick along " +
+                      kAxis[a] + ", less than the kernel support " + metres(support) +
                       ": every particle's kernel spans the block, which then holds no interior to keep its "
                       "density (a free block this thin collapses); a finer /spacing with a smaller "
                       "/solver/support resolves it");

@@ -49,18 +49,20 @@ TEST(GeometryWarnings, ANarrowGapToTheWallsNamesTheWalls) {
   EXPECT_EQ(w[0].rfind("/boundary/obstacles/0 and /boundary/walls: a gap of 0.03 m along x", 0), 0U) << w[0];
 }
 
-// A fluid block thinner than the support along y (0.03 m, under 0.04) is said; one of 0.04 m is not.
+// A fluid block thinner than the support along y (0.03 m, under 0.04) is said, named by its index in
+// /fluids (the shaped volume before it counts); one of 0.04 m is not.
 TEST(GeometryWarnings, AFluidBlockThinnerThanTheSupport) {
   auto j = nlohmann::json::parse(R"({
     "dimension": 2, "spacing": 0.01,
     "phases": [{"name": "water", "rest_density": 1000}],
     "solver": {"model": "wcsph", "support": 0.04, "eos": {"stiffness": 1e5}},
-    "fluids": [{"min": [0, 0], "max": [1, 0.03]}, {"min": [0, 0.5], "max": [1, 0.54]}],
+    "fluids": [{"sphere": {"center": [0.5, 0.8], "radius": 0.1}}, {"min": [0, 0], "max": [1, 0.03]},
+               {"min": [0, 0.5], "max": [1, 0.54]}],
     "boundary": {"model": "adami", "walls": {"min": [0, 0], "max": [1, 1], "layers": 2}}
   })");
   const auto w = load_scene<2, double>(j, "film.json").warnings;
   ASSERT_EQ(w.size(), 1U);
-  EXPECT_EQ(w[0].rfind("/fluids/0: 0.03 m thick along y, less than the kernel support 0.04 m", 0), 0U)
+  EXPECT_EQ(w[0].rfind("/fluids/1: 0.03 m thick along y, less than the kernel support 0.04 m", 0), 0U)
       << w[0];
 }
 

@@ -111,6 +111,7 @@ template <int Dim>
 struct FluidBlocks {
   std::vector<Aabb<Dim>> blocks;
   std::vector<std::int32_t> phase;  // of each block
+  std::vector<std::size_t> key;     // each block's index in /fluids (shaped volumes are numbered there too)
   // The pitch of each block's lattice along each axis: the spacing, or stretched where the spacing does not
   // divide the block (solver/initial.hpp, fluid_lattice_axis).
   std::vector<std::array<double, 3>> pitch;
