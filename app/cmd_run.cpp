@@ -30,6 +30,7 @@
 #include "cellsph/core/format.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/timer.hpp"
+#include "cellsph/distributed/communicator.hpp"
 #include "cellsph/io/frame_output.hpp"
 #include "cellsph/io/simulation_checkpoint.hpp"
 #include "cellsph/probes/probe_log.hpp"
@@ -172,6 +173,13 @@ extern "C" void on_stop_signal(int sig) {
   g_stop_signal = sig;
 }
 
+// Whether to stop before the next step: a signal to any rank stops every rank after the same step
+// (mpirun passes SIGINT and SIGTERM to each rank, which may see it a step apart). Returns the signal.
+int stop_signal(bool across_ranks) {
+  if (!across_ranks) return g_stop_signal;
+  return static_cast<int>(distributed::world().max(double(g_stop_signal)));
+}
+
 void install_stop_handlers() {
   g_stop_signal = 0;
   struct sigaction sa {};
@@ -294,13 +302,14 @@ class RunOutputs {
   RunOutputs(Simulation<Dim, Real>& sim, const Scene<Dim, Real>& scene, RunOutputSettings settings,
              const RunOptions& opt, const std::filesystem::path& out)
       : sim_(sim),
+        root_(distributed::world().rank() == 0),
         opt_(opt),
         set_(std::move(settings)),
         out_(out),
         png_dir_(out / "png"),
         surface_dir_(out / "surface"),
         ckpt_path_(out / kCheckpointFile),
-        frames_(out, set_.formats, fluid_rows(sim.particles())),
+        frames_(out, set_.formats, fluid_rows(sim)),
         frame_dt_(1.0 / set_.os.fps),
         probing_(!scene.probes.empty()),
         sampler_(scene.probes, scene.solver.density_kernel, double(scene.solver.support),
@@ -312,8 +321,8 @@ class RunOutputs {
                   {"body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"}) {
     // Pictures show what the water hits: every wall, obstacle, gate and floating body in grey, a 3D
     // tank's near walls cut away (the frames hold the fluid only; bodies.csv the bodies).
-    set_.ropt.solid = [&parts = sim.particles()](std::size_t i) {
-      return parts.kind[i] == static_cast<std::uint8_t>(ParticleKind::Boundary);
+    set_.ropt.solid = [&s = sim](std::size_t i) {
+      return s.particles().kind[i] == static_cast<std::uint8_t>(ParticleKind::Boundary);
     };
     set_.ropt.solid_radius = 0.5 * double(scene.spacing);
     rbox_.lo = scene.view_lo;
@@ -344,6 +353,7 @@ class RunOutputs {
 
   // The folders of the pictures and surfaces asked for.
   void make_folders() const {
+    if (!root_) return;
     if (opt_.render) make_folder(png_dir_);
     if (opt_.surface) make_folder(surface_dir_);
   }
@@ -351,7 +361,8 @@ class RunOutputs {
   // One row of probes.csv when the clock has passed the next sample time (one row per step at most).
   void sample_probes() {
     if (!probes_due()) return;
-    probe_log_.add(double(sim_.time()), sampler_.sample(sim_.particles()));
+    sim_.gather_for_output();
+    if (root_) probe_log_.add(double(sim_.time()), sampler_.sample(sim_.particles()));
     while (probes_due()) ++next_probe_;
   }
 
@@ -363,6 +374,8 @@ class RunOutputs {
   }
 
   void write_checkpoint() {
+    sim_.gather_for_output();
+    if (!root_) return;
     if (probing_) probe_log_.flush();
     if (floating_) body_log_.flush();  // every row up to the checkpoint's time is on disk first
     write_simulation_checkpoint(sim_, loop_.encode(), ckpt_path_);
@@ -378,7 +391,7 @@ class RunOutputs {
   }
 
   void flush_probes() {
-    if (probing_) probe_log_.flush();
+    if (probing_ && root_) probe_log_.flush();
   }
 
   // The pictures as movie.mp4, where ffmpeg is installed; the message says which.
@@ -392,10 +405,12 @@ class RunOutputs {
   [[nodiscard]] double output_ms() const { return output_ms_; }
 
  private:
-  // The rows of the frames: the fluid particles.
-  static CsvRowFilter fluid_rows(const Particles<Dim, Real>& parts) {
-    return
-        [&p = parts](std::size_t i) { return p.kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid); };
+  // The rows of the frames: the fluid particles (of the particles the simulation shows when a frame is
+  // written: in a run across ranks, those gathered on rank 0).
+  static CsvRowFilter fluid_rows(const Simulation<Dim, Real>& sim) {
+    return [&s = sim](std::size_t i) {
+      return s.particles().kind[i] == static_cast<std::uint8_t>(ParticleKind::Fluid);
+    };
   }
 
   [[nodiscard]] bool probes_due() const {
@@ -405,17 +420,22 @@ class RunOutputs {
   void write_frame() {
     Stopwatch sw;
     const double t = double(sim_.time());
+    sim_.gather_for_output();
+    if (root_) write_frame_files(t);
+    ++loop_.next_frame;
+    if (set_.os.checkpoint_every > 0 &&
+        loop_.next_frame % static_cast<std::uint64_t>(set_.os.checkpoint_every) == 0)
+      write_checkpoint();
+    output_ms_ += sw.ms();
+  }
+
+  void write_frame_files(double t) {
     if (set_.formats.any()) frames_.write(sim_.particles(), loop_.next_frame, t);
     if (opt_.render)
       render_png(sim_.particles(), set_.ropt, rbox_, t, png_dir_ / frame_file_name(loop_.next_frame, "png"));
     if (opt_.surface) write_surfaces(sim_.particles(), set_.sopt, surface_dir_, loop_.next_frame);
     if (probing_) probe_log_.flush();
     if (floating_) write_body_rows(t);
-    ++loop_.next_frame;
-    if (set_.os.checkpoint_every > 0 &&
-        loop_.next_frame % static_cast<std::uint64_t>(set_.os.checkpoint_every) == 0)
-      write_checkpoint();
-    output_ms_ += sw.ms();
   }
 
   void write_body_rows(double t) {
@@ -429,6 +449,8 @@ class RunOutputs {
   }
 
   Simulation<Dim, Real>& sim_;
+  // Rank 0 writes every file; in a run across ranks the others only take part in the gathers.
+  bool root_;
   const RunOptions& opt_;
   RunOutputSettings set_;
   RenderBox rbox_;
@@ -512,13 +534,15 @@ void step_until_done(Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
   try {
     outputs.sample_probes();
     outputs.write_due_frames();
-    while (!done() && !g_stop_signal) {
+    const bool across_ranks = sim.distributed();
+    while (!done() && !stop_signal(across_ranks)) {
       sim.step();
       warn_max_iterations(sim, progress, max_iteration_hits_seen);
       outputs.sample_probes();
       const std::uint64_t frames = outputs.next_frame();
       outputs.write_due_frames();
-      if (outputs.next_frame() != frames) warn_compressibility(sim, progress, watch);
+      if (outputs.next_frame() != frames && distributed::world().rank() == 0)
+        warn_compressibility(sim, progress, watch);
       const double frac = opt.steps >= 0
                               ? double(sim.steps()) / double(std::max<long>(opt.steps, 1))
                               : (double(sim.time()) - start.time) / std::max(end_time - start.time, 1e-300);
@@ -562,6 +586,7 @@ template <int Dim, class Real>
 int stop_with_checkpoint(int sig, const Simulation<Dim, Real>& sim, RunOutputs<Dim, Real>& outputs,
                          const RunOptions& given, const std::filesystem::path& out) {
   outputs.write_checkpoint();
+  if (distributed::world().rank() != 0) return 128 + sig;
   std::fprintf(stderr,
                "cellsph: stopped by %s at t = %.6g s, step %llu, after frame %llu, in %s; checkpoint "
                "written\ncellsph: to continue: %s\n",
@@ -585,27 +610,34 @@ int run_scene(const nlohmann::json& scene_json, const std::string& source, const
   Simulation<Dim, Real> sim(scene.solver, std::move(scene.particles));
   RunOutputs<Dim, Real> outputs(sim, scene, std::move(settings), opt, out);  // writes nothing yet
   if (resuming) outputs.resume(opt.quiet);
+  // Under mpirun: every rank built the same particles (and read the same checkpoint); each keeps its part.
+  sim.distribute(distributed::world());
+  const bool root = distributed::world().rank() == 0;  // the one rank that writes and reports
+  const bool quiet = opt.quiet || !root;
 
   // ---- Everything is valid: from here on the run writes.
-  if (g_stop_signal) {
-    std::fprintf(stderr, "cellsph: stopped by %s before the run started; nothing was written\n",
-                 signal_name(g_stop_signal));
-    return 128 + g_stop_signal;
+  if (const int sig = stop_signal(sim.distributed())) {
+    if (root)
+      std::fprintf(stderr, "cellsph: stopped by %s before the run started; nothing was written\n",
+                   signal_name(sig));
+    return 128 + sig;
   }
-  start_output(scene.derived);
+  if (root) start_output(scene.derived);
   outputs.make_folders();
 
-  Progress progress(opt.quiet);
+  Progress progress(quiet);
   const RunStart start{Stopwatch{}, sim.steps(), double(sim.time())};
-  if (!opt.quiet) print_run_header(scene, source, sim, out);
-  for (const auto& w : scene.warnings) std::fprintf(stderr, "cellsph: warning: %s\n", w.c_str());
+  if (!quiet) print_run_header(scene, source, sim, out);
+  if (root)
+    for (const auto& w : scene.warnings) std::fprintf(stderr, "cellsph: warning: %s\n", w.c_str());
   CompressibilityWatch<Dim, Real> watch;
   step_until_done(sim, outputs, progress, start, opt, watch);
   outputs.flush_probes();
-  if (const int sig = g_stop_signal) return stop_with_checkpoint(sig, sim, outputs, given, out);
+  if (const int sig = stop_signal(sim.distributed()))
+    return stop_with_checkpoint(sig, sim, outputs, given, out);
   outputs.write_end_checkpoint();
-  if (opt.render && !opt.quiet) outputs.write_movie();
-  if (!opt.quiet) print_summary(sim, start, outputs, watch, out);
+  if (opt.render && !quiet) outputs.write_movie();
+  if (!quiet) print_summary(sim, start, outputs, watch, out);
   return 0;
 }
 

@@ -188,6 +188,13 @@ void Communicator::barrier() const {
 #endif
 }
 
+void Communicator::abort(int code) const {
+#if defined(CELLSPH_HAVE_MPI)
+  if (g_active) MPI_Abort(MPI_COMM_WORLD, code);
+#endif
+  std::exit(code);
+}
+
 Communicator world() {
   return {};
 }

@@ -57,6 +57,9 @@ class Communicator {
   std::vector<std::byte> all_to_all(const std::vector<std::vector<std::byte>>& to_rank,
                                     std::vector<std::size_t>& from) const;
   void barrier() const;
+  // Ends every rank of the run with `code` (MPI_Abort): for an error on one rank that the others cannot
+  // know of, which would leave them waiting in the next collective. Without MPI: std::exit(code).
+  [[noreturn]] void abort(int code) const;
 };
 
 // The run's communicator.

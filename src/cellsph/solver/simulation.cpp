@@ -15,6 +15,7 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
 #include "cellsph/core/timer.hpp"
+#include "cellsph/distributed/rank_domain.hpp"  // the domain_ of a run across ranks
 #include "cellsph/physics/kernels.hpp"
 #include "cellsph/solver/boundary/akinci2012.hpp"
 #include "cellsph/solver/boundary/bender2019.hpp"
@@ -86,9 +87,14 @@ class HostStepContext {
   [[nodiscard]] std::size_t size() const { return s_.p_.size(); }
   [[nodiscard]] std::size_t fluid_count() const { return s_.fluid_.size(); }
   [[nodiscard]] std::size_t pair_slots() const { return s_.nl_.indices.size(); }
-  void density(const ParticleView<Dim, Real>& pv) { fluid_density_pressure(s_.cfg_, pv, s_.fluid_); }
+  void density(const ParticleView<Dim, Real>& pv) {
+    fluid_density_pressure(s_.cfg_, pv, s_.fluid_);
+    s_.share_density();
+  }
   void wall_states(const ParticleView<Dim, Real>& pv) {
-    if (s_.wall_states_) cellsph::wall_states(s_.cfg_, pv, s_.boundary_);
+    if (!s_.wall_states_) return;
+    cellsph::wall_states(s_.cfg_, pv, s_.boundary_);
+    s_.share_wall_states();
   }
   void body_loads(const ParticleView<Dim, Real>& pv) {
     if (s_.bodies_.any()) s_.compute_body_loads(pv);
@@ -101,6 +107,8 @@ class HostStepContext {
   }
   [[nodiscard]] std::uint64_t step_number() const { return s_.steps_ + 1; }
   [[nodiscard]] LeapFrogClock<Real>& clock() { return s_.clock_; }
+  [[nodiscard]] Real agree_dt(Real dt) const { return s_.domain_ ? s_.domain_->min(dt) : dt; }
+  void share_velocity() { s_.share_velocity(); }
   void forces_done() {
     s_.timings_.forces += sw_.ms();
     sw_.reset();
@@ -246,6 +254,9 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
   lists_valid_ = false;
   if (cfg_.backend != Backend::Cpu) use_backend(cfg_.backend);
 }
+
+template <int Dim, class Real>
+Simulation<Dim, Real>::~Simulation() = default;
 
 // Volume-map walls (boundary/bender2019.hpp): the solids are the map; wall particles would be counted
 // twice. The grid of the solids other than the tank has nodes a quarter support apart (half a spacing at
@@ -407,8 +418,9 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     if (lists_kept_ == 0) bare_searches_ = kBareSearches;
   }
   ++timings_.list_builds;
-  if (skin_ > 0 && bare_searches_ > 0) {
-    --bare_searches_;
+  // A run across ranks rebuilds its arrays every step: its lists never last, so it searches at h.
+  if (skin_ > 0 && (bare_searches_ > 0 || domain_)) {
+    if (bare_searches_ > 0) --bare_searches_;
     ++timings_.bare_builds;
     search_.build(std::span<const V>(p_.x), std::span<const Real>(bare_h_));
     search_.find_all(nl_);
@@ -450,9 +462,10 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::prepare_shared_arrays() {
   vol_.resize(p_.size());
   prho2_.resize(p_.size());
-  if (!wall_states_ || boundary_.empty()) return;
+  if (!wall_states_) return;
   wall_v_.resize(p_.size());
-  gather_wall_neighbors(view(), fluid_, boundary_, walls_);
+  if (boundary_.empty()) return;
+  gather_wall_neighbors(view(), row_fluid(), boundary_, walls_);
 }
 
 template <int Dim, class Real>
@@ -499,7 +512,8 @@ void Simulation<Dim, Real>::apply_walls(Real dt) {
     frames = guard_frames(cfg_, static_cast<double>(time_ + dt), static_cast<double>(dt), bodies_.states());
   const auto pass = solid_guard(cfg_.guard, view(), frames.data(),
                                 static_cast<std::int32_t>(cfg_.wall_motion.motions.size()), dt);
-  wall_corrections_ += static_cast<std::uint64_t>(reduce_sum(fluid_, pass));
+  const auto put_back = static_cast<std::uint64_t>(reduce_sum(fluid_, pass));
+  wall_corrections_ += domain_ ? domain_->sum(put_back) : put_back;
 }
 
 // After each step: the first particle (lowest index) with a non-finite quantity or outside the domain
@@ -508,18 +522,32 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::check_state() {
   const auto check = stability_check(cfg_, view());
   const std::int64_t first = first_where(fluid_, check);
-  if (first >= 0) report_unstable(first);
+  if (!domain_) {
+    if (first >= 0) report_unstable(first);
+    return;
+  }
+  // Across ranks: the lowest failing id over every rank (the single-process run's first, in id order),
+  // told by the rank that owns it.
+  const std::int64_t id = first >= 0 ? std::int64_t{p_.id[static_cast<std::size_t>(first)]} : -1;
+  const std::int64_t lowest = domain_->lowest(id);
+  if (lowest < 0) return;
+  throw SimulationError(domain_->message(id == lowest ? unstable_message(first) : std::string()));
 }
 
 // The SimulationError of check_state for fluid particle `first` (the lowest failing index).
 template <int Dim, class Real>
 void Simulation<Dim, Real>::report_unstable(std::int64_t first) const {
   sync_host();
+  throw SimulationError(unstable_message(first));
+}
+
+template <int Dim, class Real>
+std::string Simulation<Dim, Real>::unstable_message(std::int64_t first) const {
   std::ostringstream os;
   os.precision(9);
   os << "simulation unstable at step " << steps_ + 1 << " (t = " << time_
      << " s): " << describe_unstable(first);
-  throw SimulationError(os.str());
+  return os.str();
 }
 
 // An implicit solve that diverged (the SimulationError being handled, models/dfsph.hpp's
@@ -542,7 +570,8 @@ std::string Simulation<Dim, Real>::describe_unstable(std::int64_t first) const {
   const auto i = static_cast<std::size_t>(first);
   std::ostringstream os;
   os.precision(9);
-  os << "particle " << i << " (id " << p_.id[i] << "): ";
+  // Across ranks the slot of the single-process arrays is the id (they are in id order).
+  os << "particle " << (domain_ ? std::size_t{p_.id[i]} : i) << " (id " << p_.id[i] << "): ";
   auto vec = [&](const char* name, const V& v) {
     os << name << " = (";
     for (int a = 0; a < Dim; ++a) os << (a ? ", " : "") << v[a];
@@ -648,6 +677,7 @@ void Simulation<Dim, Real>::step() {
     return;
   }
   Stopwatch sw;
+  if (domain_) rebuild_domain(false);
   // On the step count alone (checkpointed), never on the list rebuilds: see the header.
   if (cfg_.reorder_every > 0 && steps_ % cfg_.reorder_every == 0) {
     reorder_slots(fluid_);
@@ -660,7 +690,7 @@ void Simulation<Dim, Real>::step() {
   timings_.neighbors += sw.ms();
 
   sw.reset();
-  filter_lists(fluid_);
+  filter_lists(row_fluid());
   prepare_shared_arrays();
   HostStepContext<Dim, Real> ctx(*this, sw);
   Real dt = 0;
@@ -686,10 +716,13 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::rebuild_kind_lists() {
   fluid_.clear();
   boundary_.clear();
+  local_fluid_.clear();
   for (std::size_t i = 0; i < p_.size(); ++i) {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
     const bool fluid = p_.kind[i] == kFluid;
-    (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
+    if (domain_ && fluid) local_fluid_.push_back(static_cast<std::uint32_t>(i));
+    if (!domain_ || domain_->owned()[i])
+      (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
     bare_h_[i] = fluid ? p_.h[i] : Real(0);
     search_h_[i] = fluid ? p_.h[i] + skin_ : Real(0);
   }

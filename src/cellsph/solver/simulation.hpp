@@ -50,6 +50,12 @@
 
 namespace cellsph {
 
+namespace distributed {
+class Communicator;
+template <int Dim, class Real>
+class RankDomain;
+}  // namespace distributed
+
 // Wall-clock time spent in each phase of step(), accumulated over all steps [ms].
 struct StepTimings {
   double neighbors = 0;           // building the search structure and the CSR lists
@@ -97,6 +103,7 @@ class Simulation {
   // m (a positive m is kept: for walls sampled on the fluid's lattice, several support lengths thick, m =
   // rho0 spacing^Dim makes the wall look exactly like fluid).
   Simulation(Config config, Particles<Dim, Real> particles);
+  ~Simulation();
 
   // One time step of the configured model (with per-particle steps: advances the particles whose own
   // time is the global clock, then the clock to the next such time). Throws SimulationError (step, particle,
@@ -114,14 +121,18 @@ class Simulation {
   // In the internal (cell) order: see "Particle order" above; particles().id names each particle.
   // With a device backend the particles are copied back here, only when the device holds newer ones
   // (at output and checkpoint times).
+  // In a run across ranks (distribute()), the particles of the last gather_for_output(): every particle on
+  // rank 0, in id order, none on the other ranks.
   [[nodiscard]] const Particles<Dim, Real>& particles() const {
+    if (domain_) return shown_;
     sync_host();
     return p_;
   }
   [[nodiscard]] const Config& config() const { return cfg_; }
   [[nodiscard]] const StepTimings& timings() const { return timings_; }
   [[nodiscard]] const SearchStats& search_stats() const { return search_.stats(); }
-  [[nodiscard]] std::size_t fluid_count() const { return fluid_count_; }
+  // Over every rank in a run across ranks.
+  [[nodiscard]] std::size_t fluid_count() const { return domain_ ? global_fluid_count_ : fluid_count_; }
   // Model::Dfsph and Model::Iisph: iterations and errors of the pressure solves (models/dfsph.hpp,
   // iisph.hpp); all 0 for the explicit models.
   [[nodiscard]] const DfsphStats& dfsph_stats() const;
@@ -141,6 +152,7 @@ class Simulation {
   // the solver state (the same order) and this integrator state. Restoring the three into a Simulation
   // built from the same config and continuing gives results bit-identical to an uninterrupted run.
   [[nodiscard]] const SolverState<Dim, Real>& solver_state() const {
+    if (domain_) return shown_state_;
     sync_host();
     return state_;
   }
@@ -183,6 +195,20 @@ class Simulation {
   // HostDevice; within rounding on a GPU (docs/gpu.md).
   void use_backend(Backend b);
   [[nodiscard]] Backend backend() const { return backend_; }
+
+  // One run across the ranks of `comm` (docs/distributed.md): called on every rank, after construction (and
+  // a resume's restore) from the same particles, it keeps on this rank the particles it owns (a range of the
+  // curve, distributed/rank_domain.hpp) and the copies its rows need; each step then moves particles to
+  // their owners and exchanges what the passes share, and every particle gets the bits of the
+  // single-process run (`neighbors.reorder_every` 0: the id order). Throws InputError, naming the key,
+  // for what the step across ranks does not run yet (only WCSPH with global steps on the CPU, without
+  // moving walls, floating bodies, emitters and reordering). With one rank: nothing changes.
+  void distribute(const distributed::Communicator& comm);
+  [[nodiscard]] bool distributed() const { return domain_ != nullptr; }
+  // A run across ranks: collective (every rank calls it at the same point): particles() and
+  // solver_state() then hold every particle on rank 0 (the outputs' and checkpoints' source). Otherwise
+  // nothing.
+  void gather_for_output();
 
  private:
   friend class HostStepContext<Dim, Real>;
@@ -249,6 +275,18 @@ class Simulation {
   // (zero-filled, for the caller to set), in every per-particle array; rebuilds the kind lists.
   void change_count(const std::vector<std::uint8_t>& keep, std::size_t added);
   void rebuild_kind_lists();
+  // A run across ranks: the particles to their owners and the halo again (first: the start's split);
+  // the kind lists then hold the owned particles, local_fluid_ every fluid particle here.
+  void rebuild_domain(bool first);
+  void check_distributable() const;
+  // The fluid whose rows a step builds: every local one in a run across ranks (halo copies too: the walls'
+  // fluid neighbours are gathered from them), else fluid_.
+  [[nodiscard]] const IndexList& row_fluid() const { return domain_ ? local_fluid_ : fluid_; }
+  // After a pass wrote fields of the owned particles: the halo copies refreshed (a run across ranks).
+  void share_density();
+  void share_wall_states();
+  void share_velocity();
+  [[nodiscard]] std::string unstable_message(std::int64_t first) const;
 
   Config cfg_;
   // Mutable: with a device backend, particles() (const) copies the device's newer state back here.
@@ -344,6 +382,14 @@ class Simulation {
 
   // Emitters and sinks (config inflow): the component with its buffer and its part of the integrator state.
   EmittersAndSinks<Dim, Real> inflow_;
+
+  // A run across ranks (distribute()): this rank's domain, the fluid held here (owned and halo), the
+  // gathered particles the outputs read, and the fluid count over every rank. Null otherwise.
+  std::unique_ptr<distributed::RankDomain<Dim, Real>> domain_;
+  IndexList local_fluid_;
+  Particles<Dim, Real> shown_;
+  SolverState<Dim, Real> shown_state_;
+  std::size_t global_fluid_count_ = 0;
 };
 
 extern template class Simulation<2, float>;

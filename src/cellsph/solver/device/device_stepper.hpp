@@ -79,6 +79,9 @@ class DeviceStepContext {
     r_.forces_ms = sw_.ms();
     sw_.reset();
   }
+  // One device is one rank: nothing to agree on or share.
+  [[nodiscard]] Real agree_dt(Real dt) const { return dt; }
+  void share_velocity() {}
   // The Simulation counts a device step's work itself.
   void count_density(std::size_t) {}
   void count_forces(std::size_t) {}

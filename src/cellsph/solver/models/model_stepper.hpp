@@ -27,6 +27,10 @@
 //   step_number()                  the step being taken, 1-based (messages)
 //   clock()                        LeapFrogClock: the last step and whether the leap-frog has started
 //   forces_done()                  the end of the force phase (the timings' split)
+//   agree_dt(dt)                   the step every rank takes (a run across ranks: the smallest of theirs)
+//   share_velocity()               after a pass changed velocities that a later pass reads of neighbours
+//                                  (a run across ranks: the halo copies refreshed; density() and
+//                                  wall_states() share their own outputs)
 //   count_density(n), count_forces(n), count_normals(n)  work done, in particles (StepTimings)
 #include <cstddef>
 #include <string>

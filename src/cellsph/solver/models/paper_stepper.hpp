@@ -42,7 +42,7 @@ class PaperStepper final : public ModelStepper<Dim, Real, Ctx> {
     paper_normals_and_forces(cfg, pv, c.fluid(), c.fluid(), normal_, tension, c.wall_states_on());
     c.forces_done();
 
-    const Real dt = global_courant_dt(cfg, pv, c.fluid());
+    const Real dt = c.agree_dt(global_courant_dt(cfg, pv, c.fluid()));
     // On the first step v(t0) becomes v(t0 + dt/2); with a changing step the kick is the mean of both.
     LeapFrogClock<Real>& clock = c.clock();
     const Real kick = clock.started ? (clock.last_dt + dt) / 2 : dt / 2;

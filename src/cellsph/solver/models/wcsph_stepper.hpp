@@ -32,12 +32,13 @@ class WcsphStepper final : public ModelStepper<Dim, Real, Ctx> {
     c.body_loads(pv);
     c.forces_done();
 
-    const Real dt = global_courant_dt(cfg, pv, c.fluid());
+    const Real dt = c.agree_dt(global_courant_dt(cfg, pv, c.fluid()));
     if (!continuity) {
       run_pass(c.fluid(), WcsphSymplecticEulerPass<Dim, Real>{pv, dt});
       return dt;
     }
     run_pass(c.fluid(), WcsphKickPass<Dim, Real>{pv, dt});
+    c.share_velocity();  // the rate reads the neighbours' kicked velocities
     continuity_rate(cfg, pv, c.fluid());
     run_pass(c.fluid(), ContinuityIntegratePass<Dim, Real>{pv, dt});
     run_pass(c.fluid(), WcsphDriftPass<Dim, Real>{pv, dt});

@@ -1,0 +1,144 @@
+// The Simulation across ranks (docs/distributed.md, issue 49): what a step does beyond one process. Each
+// rank holds the particles it owns and the halo copies its rows need, in id order (distributed/
+// rank_domain.hpp); every step moves particles to their owners first; a pass's outputs that a neighbour
+// reads are refreshed on the copies right after it (share_*); the step size and the stability check are
+// agreed over the ranks (simulation.cpp's HostStepContext::agree_dt and check_state).
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cellsph/core/error.hpp"
+#include "cellsph/distributed/rank_domain.hpp"
+#include "cellsph/solver/simulation.hpp"
+
+namespace cellsph {
+
+namespace {
+
+constexpr std::uint8_t kFluidKind = static_cast<std::uint8_t>(ParticleKind::Fluid);
+
+// A rank's arrays that travel with its particles: every particle field, the solver state and the dynamic
+// walls' fixed density, as one field list.
+template <int Dim, class Real>
+struct TravellingArrays {
+  Particles<Dim, Real>& p;
+  SolverState<Dim, Real>& s;
+  std::vector<Real>& wall_self_rho;
+  std::vector<Vec<Dim, Real>>& x;
+  std::vector<std::uint32_t>& id;
+
+  TravellingArrays(Particles<Dim, Real>& p_in, SolverState<Dim, Real>& s_in, std::vector<Real>& self_rho)
+      : p(p_in), s(s_in), wall_self_rho(self_rho), x(p_in.x), id(p_in.id) {}
+  template <class F>
+  void for_each_field(F&& fn) const {
+    p.for_each_field(fn);
+    s.for_each_field(fn);
+    fn(std::string_view("wall_self_rho"), wall_self_rho);
+  }
+  [[nodiscard]] std::size_t size() const { return p.size(); }
+  void resize(std::size_t n) const {
+    for_each_field([n](std::string_view, auto& field) { field.resize(n); });
+  }
+};
+
+}  // namespace
+
+// What the step across ranks runs so far; everything else is refused at the start, every key named.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::check_distributable() const {
+  std::vector<std::string> not_yet;
+  if (cfg_.model != Model::Wcsph)
+    not_yet.push_back("/solver/model \"" + std::string(model_name(cfg_.model)) + "\" (only \"wcsph\")");
+  if (cfg_.time.mode == TimeStepping::PerParticle) not_yet.push_back("/time/stepping \"per-particle\"");
+  if (cfg_.reorder_every > 0)
+    not_yet.push_back("/neighbors/reorder_every " + std::to_string(cfg_.reorder_every) + " (only 0)");
+  if (cfg_.wall_motion.any()) not_yet.push_back("moving walls (a \"motion\" in /boundary)");
+  if (bodies_.any()) not_yet.push_back("/bodies");
+  if (cfg_.inflow.any()) not_yet.push_back("/emitters and /sinks");
+  if (cfg_.wall_model == WallModel::VolumeMap) not_yet.push_back("/boundary/model \"volume-map\"");
+  if (backend_ != Backend::Cpu) not_yet.push_back("--backend " + std::string(backend_name(backend_)));
+  if (not_yet.empty()) return;
+  std::ostringstream os;
+  os << "a run across MPI ranks steps WCSPH with global steps on the CPU so far (docs/distributed.md); this "
+        "scene has ";
+  for (std::size_t k = 0; k < not_yet.size(); ++k) os << (k ? "; " : "") << not_yet[k];
+  os << ". Run it as one process (without mpirun), or change those keys with --set";
+  throw InputError(os.str());
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::distribute(const distributed::Communicator& comm) {
+  if (comm.size() <= 1) return;
+  check_distributable();
+  V lo = p_.x.empty() ? V{} : p_.x[0];
+  for (const V& x : p_.x)
+    for (int a = 0; a < Dim; ++a) lo[a] = std::min(lo[a], x[a]);
+  // The halo's reach: a row's (the support) with the Verlet skin's margin, at least a sixteenth of h, so
+  // that a pair at exactly h never falls two curve cells apart through rounding.
+  const double reach = double(cfg_.support) + std::max(double(skin_), double(cfg_.support) / 16);
+  domain_ = std::make_unique<distributed::RankDomain<Dim, Real>>(comm, lo, reach);
+  global_fluid_count_ = fluid_count_;
+  wall_self_rho_.resize(p_.size());  // travels with every particle (0 but for dynamic walls)
+  rebuild_domain(true);
+  gather_for_output();
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::rebuild_domain(bool first) {
+  TravellingArrays<Dim, Real> arrays(p_, state_, wall_self_rho_);
+  // The start's split weighs a fluid particle as four wall particles (its row's passes against a wall's
+  // state pass); every later step keeps those cuts.
+  if (first)
+    domain_->start(arrays, [&](std::size_t i) { return p_.kind[i] == kFluidKind ? 4 : 1; });
+  else
+    domain_->rebuild(arrays);
+  const std::size_t n = p_.size();
+  rho0_.assign(n, Real(0));
+  search_h_.assign(n, Real(0));
+  bare_h_.assign(n, Real(0));
+  rebuild_kind_lists();
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::share_density() {
+  if (!domain_) return;
+  domain_->refresh(p_.rho, p_.p, vol_, prho2_);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::share_wall_states() {
+  if (!domain_) return;
+  domain_->refresh(p_.rho, p_.p, vol_, prho2_, wall_v_);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::share_velocity() {
+  if (domain_) domain_->refresh(p_.v);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::gather_for_output() {
+  if (!domain_) return;
+  TravellingArrays<Dim, Real> arrays(p_, state_, wall_self_rho_);
+  std::vector<Real> self_rho;
+  TravellingArrays<Dim, Real> out(shown_, shown_state_, self_rho);
+  domain_->gather_to_root(arrays, out);
+}
+
+#define CELLSPH_SIMULATION_RANKS(D, R)                                          \
+  template void Simulation<D, R>::check_distributable() const;                  \
+  template void Simulation<D, R>::distribute(const distributed::Communicator&); \
+  template void Simulation<D, R>::rebuild_domain(bool);                         \
+  template void Simulation<D, R>::share_density();                              \
+  template void Simulation<D, R>::share_wall_states();                          \
+  template void Simulation<D, R>::share_velocity();                             \
+  template void Simulation<D, R>::gather_for_output();
+CELLSPH_SIMULATION_RANKS(2, float)
+CELLSPH_SIMULATION_RANKS(2, double)
+CELLSPH_SIMULATION_RANKS(3, float)
+CELLSPH_SIMULATION_RANKS(3, double)
+#undef CELLSPH_SIMULATION_RANKS
+
+}  // namespace cellsph
