@@ -214,7 +214,10 @@ std::string shortest(double v) {
 // The command that continues this run: the folder, plus what this invocation set that run.json does not
 // keep (the thread count, and the overrides given to a --resume).
 std::string resume_command(const RunOptions& given, const std::filesystem::path& out) {
-  std::string c = shell_word(program_name()) + " run --resume " + shell_word(out.string());
+  // Across ranks: the same launcher line (any rank count resumes it; docs/distributed.md).
+  const int ranks = distributed::world().size();
+  std::string c = ranks > 1 ? "mpirun -np " + std::to_string(ranks) + " " : "";
+  c += shell_word(program_name()) + " run --resume " + shell_word(out.string());
   if (given.threads > 0) c += " --threads " + std::to_string(given.threads);
   if (!given.resume.empty()) {
     if (given.until > 0) c += " --until " + shortest(given.until);

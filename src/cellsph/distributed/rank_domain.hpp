@@ -106,6 +106,7 @@ class RankDomain {
   // The smallest of every rank's value (a step size: each rank's is a monotone function of its maximum,
   // so the smallest is the single-process step, bit for bit).
   [[nodiscard]] Real min(Real value) const { return static_cast<Real>(-comm_.max(-double(value))); }
+  [[nodiscard]] Real max(Real value) const { return static_cast<Real>(comm_.max(double(value))); }
   [[nodiscard]] std::uint64_t sum(std::uint64_t value) const {
     auto v = static_cast<std::int64_t>(value);
     comm_.sum_in_place(&v, 1);

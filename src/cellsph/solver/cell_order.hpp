@@ -18,12 +18,33 @@ namespace cellsph {
 
 // Z-order (Morton) key of a cell: the bits of the cell coordinates interleaved, so that cells close in
 // space are mostly close in the key and each block of 2^Dim, 4^Dim, ... cells is contiguous.
+// Bit b of the low 64 / Dim bits of v moved to bit Dim * b (the others 0): the usual shift-and-mask
+// spreading, a few operations instead of a loop over the bits.
+template <int Dim>
+constexpr std::uint64_t spread_bits(std::uint64_t v) {
+  if constexpr (Dim == 2) {
+    v &= 0xffffffffULL;
+    v = (v | (v << 16)) & 0x0000ffff0000ffffULL;
+    v = (v | (v << 8)) & 0x00ff00ff00ff00ffULL;
+    v = (v | (v << 4)) & 0x0f0f0f0f0f0f0f0fULL;
+    v = (v | (v << 2)) & 0x3333333333333333ULL;
+    v = (v | (v << 1)) & 0x5555555555555555ULL;
+  } else {
+    static_assert(Dim == 3, "morton keys of 2 or 3 coordinates");
+    v &= 0x1fffffULL;
+    v = (v | (v << 32)) & 0x1f00000000ffffULL;
+    v = (v | (v << 16)) & 0x1f0000ff0000ffULL;
+    v = (v | (v << 8)) & 0x100f00f00f00f00fULL;
+    v = (v | (v << 4)) & 0x10c30c30c30c30c3ULL;
+    v = (v | (v << 2)) & 0x1249249249249249ULL;
+  }
+  return v;
+}
+
 template <int Dim>
 std::uint64_t morton_key(const std::uint64_t (&c)[Dim]) {
-  constexpr int bits = 64 / Dim;
   std::uint64_t key = 0;
-  for (int b = 0; b < bits; ++b)
-    for (int a = 0; a < Dim; ++a) key |= ((c[a] >> b) & 1u) << (b * Dim + a);
+  for (int a = 0; a < Dim; ++a) key |= spread_bits<Dim>(c[a]) << a;
   return key;
 }
 

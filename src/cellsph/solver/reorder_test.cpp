@@ -11,6 +11,7 @@
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/core/parallel.hpp"
+#include "cellsph/solver/cell_order.hpp"
 #include "cellsph/solver/initial.hpp"
 #include "cellsph/solver/simulation.hpp"
 #include "cellsph/solver/solver_test_util.hpp"
@@ -51,6 +52,29 @@ bool is_permutation_of_iota(std::vector<std::uint32_t> id) {
   for (std::size_t k = 0; k < id.size(); ++k)
     if (id[k] != k) return false;
   return true;
+}
+
+// The Z-order key against its definition, bit by bit: bit b of coordinate a is bit Dim * b + a of the key
+// (64 / Dim bits a coordinate, higher bits ignored).
+template <int Dim>
+std::uint64_t morton_by_definition(const std::uint64_t (&c)[Dim]) {
+  std::uint64_t key = 0;
+  for (int b = 0; b < 64 / Dim; ++b)
+    for (int a = 0; a < Dim; ++a) key |= ((c[a] >> b) & 1u) << (b * Dim + a);
+  return key;
+}
+
+TEST(Reorder, MortonKeyInterleavesTheBits) {
+  std::mt19937_64 rng(77);
+  for (int t = 0; t < 100000; ++t) {
+    const int shift = t % 64;  // small and large coordinates, bits above the key's share included
+    const std::uint64_t c2[2] = {rng() >> shift, rng() >> (63 - shift)};
+    const std::uint64_t c3[3] = {rng() >> shift, rng() >> (t % 40), rng() >> (63 - shift)};
+    ASSERT_EQ(morton_key<2>(c2), morton_by_definition<2>(c2)) << c2[0] << " " << c2[1];
+    ASSERT_EQ(morton_key<3>(c3), morton_by_definition<3>(c3)) << c3[0] << " " << c3[1] << " " << c3[2];
+  }
+  const std::uint64_t ones3[3] = {0x1fffff, 0, 0};
+  EXPECT_EQ(morton_key<3>(ones3), 0x1249249249249249ULL);
 }
 
 TEST(Reorder, SamePhysicsPerIdAsNoReorder) {

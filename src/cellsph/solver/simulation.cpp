@@ -257,6 +257,10 @@ Simulation<Dim, Real>::Simulation(Config config, Particles<Dim, Real> particles)
 
 template <int Dim, class Real>
 Simulation<Dim, Real>::~Simulation() = default;
+template <int Dim, class Real>
+Simulation<Dim, Real>::Simulation(Simulation&&) = default;
+template <int Dim, class Real>
+Simulation<Dim, Real>& Simulation<Dim, Real>::operator=(Simulation&&) = default;
 
 // Volume-map walls (boundary/bender2019.hpp): the solids are the map; wall particles would be counted
 // twice. The grid of the solids other than the tank has nodes a quarter support apart (half a spacing at
@@ -404,7 +408,8 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     // The largest squared displacement since the lists were built (order-free: a maximum).
     // Moving walls count too: a pair's distance changes by at most the sum of both displacements.
     const MaxDisplacementPass<Dim, Real> disp{view(), x_built_.data()};
-    Real d2 = reduce_max(fluid_, MaxValue<Real>{}, disp).value;
+    // Across ranks the halo copies count too (their owners move them).
+    Real d2 = reduce_max(row_fluid(), MaxValue<Real>{}, disp).value;
     if (moving_.any()) d2 = std::max(d2, reduce_max(moving_.slots(), MaxValue<Real>{}, disp).value);
     if (bodies_.any()) d2 = std::max(d2, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
@@ -418,9 +423,8 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     if (lists_kept_ == 0) bare_searches_ = kBareSearches;
   }
   ++timings_.list_builds;
-  // A run across ranks rebuilds its arrays every step: its lists never last, so it searches at h.
-  if (skin_ > 0 && (bare_searches_ > 0 || domain_)) {
-    if (bare_searches_ > 0) --bare_searches_;
+  if (skin_ > 0 && bare_searches_ > 0) {
+    --bare_searches_;
     ++timings_.bare_builds;
     search_.build(std::span<const V>(p_.x), std::span<const Real>(bare_h_));
     search_.find_all(nl_);
@@ -677,7 +681,7 @@ void Simulation<Dim, Real>::step() {
     return;
   }
   Stopwatch sw;
-  if (domain_) rebuild_domain(false);
+  if (domain_) update_domain();
   // On the step count alone (checkpointed), never on the list rebuilds: see the header.
   if (cfg_.reorder_every > 0 && steps_ % cfg_.reorder_every == 0) {
     reorder_slots(fluid_);

@@ -58,13 +58,14 @@ class RankDomain;
 
 // Wall-clock time spent in each phase of step(), accumulated over all steps [ms].
 struct StepTimings {
-  double neighbors = 0;           // building the search structure and the CSR lists
-  double forces = 0;              // density, pressure, forces
-  double integration = 0;         // time step choice, integration, walls, stability check
-  std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
-  std::uint64_t bare_builds = 0;  // of which at the bare supports (skinned lists did not last a step)
-  double reorder = 0;             // permuting the particles into cell order (config reorder_every)
-  std::uint64_t reorders = 0;     // reorders run
+  double neighbors = 0;               // building the search structure and the CSR lists
+  double forces = 0;                  // density, pressure, forces
+  double integration = 0;             // time step choice, integration, walls, stability check
+  std::uint64_t list_builds = 0;      // neighbour searches run (Verlet lists are kept between them)
+  std::uint64_t bare_builds = 0;      // of which at the bare supports (skinned lists did not last a step)
+  double reorder = 0;                 // permuting the particles into cell order (config reorder_every)
+  std::uint64_t reorders = 0;         // reorders run
+  std::uint64_t domain_rebuilds = 0;  // across ranks: particles moved to their owners, the halo rebuilt
   // Work done, in particles (summed over steps): a global step evaluates every fluid particle once; a
   // per-particle sub-step only the particles it integrates and those their forces read.
   std::uint64_t density_evals = 0;  // densities and pressures (eq. 7 + equation of state)
@@ -104,6 +105,8 @@ class Simulation {
   // rho0 spacing^Dim makes the wall look exactly like fluid).
   Simulation(Config config, Particles<Dim, Real> particles);
   ~Simulation();
+  Simulation(Simulation&&);
+  Simulation& operator=(Simulation&&);
 
   // One time step of the configured model (with per-particle steps: advances the particles whose own
   // time is the global clock, then the clock to the next such time). Throws SimulationError (step, particle,
@@ -278,6 +281,9 @@ class Simulation {
   // A run across ranks: the particles to their owners and the halo again (first: the start's split);
   // the kind lists then hold the owned particles, local_fluid_ every fluid particle here.
   void rebuild_domain(bool first);
+  // Each step across ranks: the domain rebuilt when a particle has moved more than its margin allows
+  // (every rank agrees), else the halo copies' positions and velocities refreshed.
+  void update_domain();
   void check_distributable() const;
   // The fluid whose rows a step builds: every local one in a run across ranks (halo copies too: the walls'
   // fluid neighbours are gathered from them), else fluid_.
@@ -390,6 +396,9 @@ class Simulation {
   Particles<Dim, Real> shown_;
   SolverState<Dim, Real> shown_state_;
   std::size_t global_fluid_count_ = 0;
+  std::vector<V>
+      x_domain_;  // positions at the domain's last rebuild (its halo's margin is measured from them)
+  Real domain_margin_ = 0;  // the halo's reach beyond the support
 };
 
 extern template class Simulation<2, float>;

@@ -12,6 +12,8 @@
 #include "cellsph/core/error.hpp"
 #include "cellsph/distributed/rank_domain.hpp"
 #include "cellsph/solver/simulation.hpp"
+#include "cellsph/solver/pass_driver.hpp"
+#include "cellsph/solver/verlet_rows.hpp"
 
 namespace cellsph {
 
@@ -75,10 +77,13 @@ void Simulation<Dim, Real>::distribute(const distributed::Communicator& comm) {
   V lo = p_.x.empty() ? V{} : p_.x[0];
   for (const V& x : p_.x)
     for (int a = 0; a < Dim; ++a) lo[a] = std::min(lo[a], x[a]);
-  // The halo's reach: a row's (the support) with the Verlet skin's margin, at least a sixteenth of h, so
-  // that a pair at exactly h never falls two curve cells apart through rounding.
-  const double reach = double(cfg_.support) + std::max(double(skin_), double(cfg_.support) / 16);
-  domain_ = std::make_unique<distributed::RankDomain<Dim, Real>>(comm, lo, reach);
+  // The halo's margin beyond the support: half of it (or the Verlet skin, if longer). A wider margin keeps
+  // the domain for more steps (a rebuild moves and sorts every particle) and refreshes more copies each
+  // step: on the default scene on 2 ranks, a margin of 0.15 h rebuilt every 3-4 steps and took 10-20%
+  // longer than 0.5 h (docs/distributed.md).
+  domain_margin_ = std::max(skin_, cfg_.support / 2);
+  domain_ = std::make_unique<distributed::RankDomain<Dim, Real>>(
+      comm, lo, double(cfg_.support) + double(domain_margin_));
   global_fluid_count_ = fluid_count_;
   wall_self_rho_.resize(p_.size());  // travels with every particle (0 but for dynamic walls)
   rebuild_domain(true);
@@ -99,6 +104,24 @@ void Simulation<Dim, Real>::rebuild_domain(bool first) {
   search_h_.assign(n, Real(0));
   bare_h_.assign(n, Real(0));
   rebuild_kind_lists();
+  x_domain_ = p_.x;
+}
+
+// The halo holds every particle within the support plus the margin of an owned one, as they stood at the
+// rebuild. While no particle has moved more than 0.45 of the margin since (the largest displacement over
+// every rank), a pair within the support now was within support + 0.9 margin then: the halo still holds
+// every row's particles, and only the copies' positions and velocities need their owners' new values.
+template <int Dim, class Real>
+void Simulation<Dim, Real>::update_domain() {
+  const MaxDisplacementPass<Dim, Real> disp{view(), x_domain_.data()};
+  const Real d2 = domain_->max(reduce_max(fluid_, MaxValue<Real>{}, disp).value);
+  const Real limit = Real(0.45) * domain_margin_;
+  if (d2 <= limit * limit) {
+    domain_->refresh(p_.x, p_.v);
+    return;
+  }
+  rebuild_domain(false);
+  ++timings_.domain_rebuilds;
 }
 
 template <int Dim, class Real>
@@ -131,6 +154,7 @@ void Simulation<Dim, Real>::gather_for_output() {
   template void Simulation<D, R>::check_distributable() const;                  \
   template void Simulation<D, R>::distribute(const distributed::Communicator&); \
   template void Simulation<D, R>::rebuild_domain(bool);                         \
+  template void Simulation<D, R>::update_domain();                              \
   template void Simulation<D, R>::share_density();                              \
   template void Simulation<D, R>::share_wall_states();                          \
   template void Simulation<D, R>::share_velocity();                             \
