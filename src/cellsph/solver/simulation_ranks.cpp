@@ -11,8 +11,8 @@
 
 #include "cellsph/core/error.hpp"
 #include "cellsph/distributed/rank_domain.hpp"
-#include "cellsph/solver/simulation.hpp"
 #include "cellsph/solver/pass_driver.hpp"
+#include "cellsph/solver/simulation.hpp"
 #include "cellsph/solver/verlet_rows.hpp"
 
 namespace cellsph {
