@@ -59,6 +59,14 @@ case "$case_name" in
     same "probes" 3 lobovsky-2014 --set /spacing=0.008 --set /solver/support=0.016 --until 0.05 --format csv \
       --fps 50
     [ -s np3_probes/probes.csv ] || fail "probes: no probes.csv"
+    # A rebalance at every rebuild of the domain (threshold 1e-6) moves particles between ranks far more
+    # often: still the same bytes, and the summary counts the rebalances.
+    same "rebalance" 3 dam-break-2d "${coarse[@]}" --set /parallel/rebalance_threshold=1e-6 --until 0.15 \
+      --format csv --fps 20
+    summary=$(ranks 3 run dam-break-2d "${coarse[@]}" --set /parallel/rebalance_threshold=1e-6 --until 0.15 \
+      --format csv --fps 20 --out summary 2>&1)
+    grep -q 'ranks: 3, domain rebuilt [1-9][0-9]* times, rebalanced [1-9][0-9]* times' <<<"$summary" ||
+      fail "rebalance: no rebalance in the summary: $summary"
     ;;
   resume)
     # Checkpointed on 2 ranks at 0.1 s, resumed on 3 to 0.2 s: the frames and the last checkpoint of the run

@@ -581,6 +581,15 @@ void print_summary(const Simulation<Dim, Real>& sim, const RunStart& start,
   for (const std::string& line : sim.solver_summary()) std::fprintf(stderr, "         %s\n", line.c_str());
   for (const std::string& line : watch.given()) std::fprintf(stderr, "         warning: %s\n", line.c_str());
   print_wall_corrections(sim, double(sim.time()) - start.time);
+  if (sim.distributed()) {
+    const RankStats& r = sim.rank_stats();
+    std::fprintf(
+        stderr,
+        "         ranks: %d, domain rebuilt %llu times, rebalanced %llu times; work imbalance %.1f%% at "
+        "the last rebuild, %.1f%% at most (times above are rank 0's)\n",
+        r.ranks, static_cast<unsigned long long>(r.rebuilds), static_cast<unsigned long long>(r.rebalances),
+        100 * r.imbalance, 100 * r.max_imbalance);
+  }
 }
 
 // Stopped between two steps: the state after the last step, with its frame counter, so the resume

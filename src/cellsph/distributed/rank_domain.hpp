@@ -68,6 +68,21 @@ class RankDomain {
     add_own_halo(p);
   }
 
+  // The curve cut again by the owned particles' work (`weight(i)` > 0 for each owned slot i): the ranks'
+  // shares even out at the next rebuild, which moves the particles by the new cuts.
+  template <class Soa, class Weight>
+  void recut(const Soa& p, Weight&& weight) {
+    std::vector<std::uint64_t> keys;
+    std::vector<std::int64_t> weights;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!owned_[i]) continue;
+      keys.push_back(grid_.key(p.x[i]));
+      weights.push_back(static_cast<std::int64_t>(weight(i)));
+    }
+    split_ = split_curve(keys, weights, Dim * grid_.bits, comm_.size(), kTolerance,
+                         [this](std::int64_t* v, int count) { comm_.sum_in_place(v, count); });
+  }
+
   // Each step: the halo dropped, the owned particles sent to the ranks that own their keys now (the cuts
   // stay), and the halo received again for the new positions.
   template <class Soa>

@@ -1,4 +1,5 @@
-// /neighbors (docs/scenes.md, "neighbors"): the neighbour search, its Verlet skin and the reorder.
+// /neighbors (docs/scenes.md, "neighbors"): the neighbour search, its Verlet skin and the reorder; and
+// /parallel (docs/scenes.md, "parallel"): how a run across MPI ranks balances its work.
 #include "cellsph/scene/scene_readers.hpp"
 
 namespace cellsph::scene_detail {
@@ -18,8 +19,17 @@ void read_neighbors(JsonReader& r, SolverConfig<Dim, Real>& cfg) {
   nr.finish();
 }
 
+template <int Dim, class Real>
+void read_parallel(JsonReader& r, SolverConfig<Dim, Real>& cfg) {
+  if (!r.has("parallel")) return;
+  auto pr = r.child("parallel");
+  cfg.rebalance_threshold = pr.number("rebalance_threshold", cfg.rebalance_threshold, 1e-6, 10);
+  pr.finish();
+}
+
 #define CELLSPH_NEIGHBORS_INSTANTIATE(D, R) \
-  template void read_neighbors<D, R>(JsonReader&, SolverConfig<D, R>&);
+  template void read_neighbors<D, R>(JsonReader&, SolverConfig<D, R>&); \
+  template void read_parallel<D, R>(JsonReader&, SolverConfig<D, R>&);
 CELLSPH_NEIGHBORS_INSTANTIATE(2, float)
 CELLSPH_NEIGHBORS_INSTANTIATE(2, double)
 CELLSPH_NEIGHBORS_INSTANTIATE(3, float)

@@ -70,6 +70,7 @@ Scene<Dim, Real> load_scene(const nlohmann::json& j, const std::string& source, 
   read_solver(r, spacing, cfg);
   read_time(r, cfg, s.output);
   read_neighbors(r, cfg);
+  read_parallel(r, cfg);
 
   // Particles: counted (fluid blocks first) before each is made, boundary before fluid.
   ParticleBudget budget(Dim, spacing, double(cfg.support) * (1 + double(cfg.verlet_skin)) / spacing,

@@ -138,6 +138,9 @@ void read_time(JsonReader& r, SolverConfig<Dim, Real>& cfg, OutputSettings& out)
 // /neighbors (neighbors_reader.cpp).
 template <int Dim, class Real>
 void read_neighbors(JsonReader& r, SolverConfig<Dim, Real>& cfg);
+// /parallel (neighbors_reader.cpp).
+template <int Dim, class Real>
+void read_parallel(JsonReader& r, SolverConfig<Dim, Real>& cfg);
 
 // The shape of an obstacle, body or fluid volume at `e`: "mesh", "sphere" or "cylinder" (docs/scenes.md,
 // "Shapes"); nothing when it is a box ("min", "max") (shapes_reader.cpp).

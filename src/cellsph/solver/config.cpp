@@ -45,6 +45,9 @@ void validate_numbers(const SolverConfig<Dim, Real>& c) {
   positive("time.dt", c.time.dt);
   positive("time.dt_max", c.time.dt_max);
   non_negative("time.dt_column", c.time.dt_column);
+  if (!(c.rebalance_threshold > 0 && c.rebalance_threshold <= 10))
+    throw InputError("parallel.rebalance_threshold: " + std::to_string(c.rebalance_threshold) +
+                     " (a fraction of the mean work, above 0 and at most 10)");
   positive("time.courant", c.time.courant);
   positive("time.viscous", c.time.viscous);
   positive("time.force", c.time.force);

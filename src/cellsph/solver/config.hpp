@@ -373,6 +373,11 @@ struct SolverConfig {
   // every particle is due. Results depend on it only through summation order (last bits), never on
   // the method, skin or thread count; the id field keeps each particle's identity.
   std::uint32_t reorder_every = 0;
+  // A run across MPI ranks (docs/distributed.md): when the domain is rebuilt and the busiest rank's work
+  // (its fluid particles' neighbour pairs, plus four a particle, plus one a wall particle) exceeds the
+  // ranks' mean by more than this fraction, the curve is cut again by the measured work. Scene key
+  // /parallel/rebalance_threshold.
+  double rebalance_threshold = 0.1;
   std::uint64_t seed = 1;
 
   static constexpr V gravity_default() {

@@ -58,19 +58,27 @@ class RankDomain;
 
 // Wall-clock time spent in each phase of step(), accumulated over all steps [ms].
 struct StepTimings {
-  double neighbors = 0;               // building the search structure and the CSR lists
-  double forces = 0;                  // density, pressure, forces
-  double integration = 0;             // time step choice, integration, walls, stability check
-  std::uint64_t list_builds = 0;      // neighbour searches run (Verlet lists are kept between them)
-  std::uint64_t bare_builds = 0;      // of which at the bare supports (skinned lists did not last a step)
-  double reorder = 0;                 // permuting the particles into cell order (config reorder_every)
-  std::uint64_t reorders = 0;         // reorders run
-  std::uint64_t domain_rebuilds = 0;  // across ranks: particles moved to their owners, the halo rebuilt
+  double neighbors = 0;           // building the search structure and the CSR lists
+  double forces = 0;              // density, pressure, forces
+  double integration = 0;         // time step choice, integration, walls, stability check
+  std::uint64_t list_builds = 0;  // neighbour searches run (Verlet lists are kept between them)
+  std::uint64_t bare_builds = 0;  // of which at the bare supports (skinned lists did not last a step)
+  double reorder = 0;             // permuting the particles into cell order (config reorder_every)
+  std::uint64_t reorders = 0;     // reorders run
   // Work done, in particles (summed over steps): a global step evaluates every fluid particle once; a
   // per-particle sub-step only the particles it integrates and those their forces read.
   std::uint64_t density_evals = 0;  // densities and pressures (eq. 7 + equation of state)
   std::uint64_t normal_evals = 0;   // CSF colour normals
   std::uint64_t force_evals = 0;    // forces (eq. 8-9)
+};
+
+// A run across ranks (Simulation::distribute): how its domain went.
+struct RankStats {
+  int ranks = 1;
+  std::uint64_t rebuilds = 0;    // particles moved to their owners and the halo built again
+  std::uint64_t rebalances = 0;  // the curve cut again by the measured work
+  double imbalance = 0;          // at the last rebuild: the busiest rank's work over the mean, less 1
+  double max_imbalance = 0;      // the largest of those
 };
 
 // What step() carries from one step to the next besides the particles.
@@ -208,6 +216,9 @@ class Simulation {
   // moving walls, floating bodies, emitters and reordering). With one rank: nothing changes.
   void distribute(const distributed::Communicator& comm);
   [[nodiscard]] bool distributed() const { return domain_ != nullptr; }
+  // A run across ranks: its ranks, rebuilds of the domain, rebalances and the work's imbalance (the same on
+  // every rank).
+  [[nodiscard]] const RankStats& rank_stats() const { return rank_stats_; }
   // A run across ranks: collective (every rank calls it at the same point): particles() and
   // solver_state() then hold every particle on rank 0 (the outputs' and checkpoints' source). Otherwise
   // nothing.
@@ -284,6 +295,10 @@ class Simulation {
   // Each step across ranks: the domain rebuilt when a particle has moved more than its margin allows
   // (every rank agrees), else the halo copies' positions and velocities refreshed.
   void update_domain();
+  // The work of the particles this rank owns (the split's weights), and the curve cut again by it when the
+  // busiest rank's exceeds the mean by more than rebalance_threshold.
+  [[nodiscard]] std::int64_t owned_work(std::size_t i) const;
+  void balance_domain();
   void check_distributable() const;
   // The fluid whose rows a step builds: every local one in a run across ranks (halo copies too: the walls'
   // fluid neighbours are gathered from them), else fluid_.
@@ -399,6 +414,7 @@ class Simulation {
   std::vector<V>
       x_domain_;  // positions at the domain's last rebuild (its halo's margin is measured from them)
   Real domain_margin_ = 0;  // the halo's reach beyond the support
+  RankStats rank_stats_;
 };
 
 extern template class Simulation<2, float>;

@@ -85,6 +85,8 @@ void Simulation<Dim, Real>::distribute(const distributed::Communicator& comm) {
   domain_ = std::make_unique<distributed::RankDomain<Dim, Real>>(
       comm, lo, double(cfg_.support) + double(domain_margin_));
   global_fluid_count_ = fluid_count_;
+  rank_stats_ = RankStats{};
+  rank_stats_.ranks = comm.size();
   wall_self_rho_.resize(p_.size());  // travels with every particle (0 but for dynamic walls)
   rebuild_domain(true);
   gather_for_output();
@@ -120,8 +122,37 @@ void Simulation<Dim, Real>::update_domain() {
     domain_->refresh(p_.x, p_.v);
     return;
   }
+  balance_domain();
   rebuild_domain(false);
-  ++timings_.domain_rebuilds;
+  ++rank_stats_.rebuilds;
+}
+
+// A fluid particle's work is its row's pairs plus four (its own loads and stores, as the threads' split
+// weighs it), a wall particle's one (its state pass); a halo copy's none.
+template <int Dim, class Real>
+std::int64_t Simulation<Dim, Real>::owned_work(std::size_t i) const {
+  if (p_.kind[i] != kFluidKind) return 1;
+  return std::int64_t{4} + (i < within_count_.size() ? std::int64_t{within_count_[i]} : 0);
+}
+
+template <int Dim, class Real>
+void Simulation<Dim, Real>::balance_domain() {
+  std::int64_t work = 0;
+  for (std::size_t i = 0; i < p_.size(); ++i)
+    if (domain_->owned()[i]) work += owned_work(i);
+  const std::vector<std::int64_t> all = domain_->comm().all_gather({work});
+  std::int64_t busiest = 0, total = 0;
+  for (const std::int64_t w : all) {
+    busiest = std::max(busiest, w);
+    total += w;
+  }
+  const double mean = double(total) / double(all.size());
+  rank_stats_.imbalance = mean > 0 ? double(busiest) / mean - 1 : 0;
+  rank_stats_.max_imbalance = std::max(rank_stats_.max_imbalance, rank_stats_.imbalance);
+  if (rank_stats_.imbalance <= cfg_.rebalance_threshold) return;
+  TravellingArrays<Dim, Real> arrays(p_, state_, wall_self_rho_);
+  domain_->recut(arrays, [&](std::size_t i) { return owned_work(i); });
+  ++rank_stats_.rebalances;
 }
 
 template <int Dim, class Real>
@@ -155,6 +186,8 @@ void Simulation<Dim, Real>::gather_for_output() {
   template void Simulation<D, R>::distribute(const distributed::Communicator&); \
   template void Simulation<D, R>::rebuild_domain(bool);                         \
   template void Simulation<D, R>::update_domain();                              \
+  template std::int64_t Simulation<D, R>::owned_work(std::size_t) const;        \
+  template void Simulation<D, R>::balance_domain();                             \
   template void Simulation<D, R>::share_density();                              \
   template void Simulation<D, R>::share_wall_states();                          \
   template void Simulation<D, R>::share_velocity();                             \
