@@ -59,6 +59,9 @@ case "$case_name" in
     same "probes" 3 lobovsky-2014 --set /spacing=0.008 --set /solver/support=0.016 --until 0.05 --format csv \
       --fps 50
     [ -s np3_probes/probes.csv ] || fail "probes: no probes.csv"
+    # Moving walls: the gate (Adami's walls read the walls' accelerations) and the wave maker's paddle.
+    same "gate" 3 dam-break-gate "${coarse[@]}" --until 0.2 --format csv --fps 20
+    same "paddle" 2 wave-tank "${coarse[@]}" --until 0.3 --format csv --fps 10
     # A rebalance at every rebuild of the domain (threshold 1e-6) moves particles between ranks far more
     # often: still the same bytes, and the summary counts the rebalances.
     same "rebalance" 3 dam-break-2d "${coarse[@]}" --set /parallel/rebalance_threshold=1e-6 --until 0.15 \

@@ -411,6 +411,8 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     // Across ranks the halo copies count too (their owners move them).
     Real d2 = reduce_max(row_fluid(), MaxValue<Real>{}, disp).value;
     if (moving_.any()) d2 = std::max(d2, reduce_max(moving_.slots(), MaxValue<Real>{}, disp).value);
+    // Across ranks the moving walls' halo copies too (a wall at rest has not moved).
+    if (domain_ && moving_.any()) d2 = std::max(d2, reduce_max(local_walls_, MaxValue<Real>{}, disp).value);
     if (bodies_.any()) d2 = std::max(d2, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
     if (d2 <= limit * limit) {
@@ -721,10 +723,11 @@ void Simulation<Dim, Real>::rebuild_kind_lists() {
   fluid_.clear();
   boundary_.clear();
   local_fluid_.clear();
+  local_walls_.clear();
   for (std::size_t i = 0; i < p_.size(); ++i) {
     rho0_[i] = cfg_.phases[static_cast<std::size_t>(p_.phase[i])].rest_density;
     const bool fluid = p_.kind[i] == kFluid;
-    if (domain_ && fluid) local_fluid_.push_back(static_cast<std::uint32_t>(i));
+    if (domain_) (fluid ? local_fluid_ : local_walls_).push_back(static_cast<std::uint32_t>(i));
     if (!domain_ || domain_->owned()[i])
       (fluid ? fluid_ : boundary_).push_back(static_cast<std::uint32_t>(i));
     bare_h_[i] = fluid ? p_.h[i] : Real(0);

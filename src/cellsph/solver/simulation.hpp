@@ -213,7 +213,7 @@ class Simulation {
   // their owners and exchanges what the passes share, and every particle gets the bits of the
   // single-process run (`neighbors.reorder_every` 0: the id order). Throws InputError, naming the key,
   // for what the step across ranks does not run yet (only WCSPH with global steps on the CPU, without
-  // moving walls, floating bodies, emitters and reordering). With one rank: nothing changes.
+  // floating bodies, emitters and reordering). With one rank: nothing changes.
   void distribute(const distributed::Communicator& comm);
   [[nodiscard]] bool distributed() const { return domain_ != nullptr; }
   // A run across ranks: its ranks, rebuilds of the domain, rebalances and the work's imbalance (the same on
@@ -407,7 +407,7 @@ class Simulation {
   // A run across ranks (distribute()): this rank's domain, the fluid held here (owned and halo), the
   // gathered particles the outputs read, and the fluid count over every rank. Null otherwise.
   std::unique_ptr<distributed::RankDomain<Dim, Real>> domain_;
-  IndexList local_fluid_;
+  IndexList local_fluid_, local_walls_;
   Particles<Dim, Real> shown_;
   SolverState<Dim, Real> shown_state_;
   std::size_t global_fluid_count_ = 0;

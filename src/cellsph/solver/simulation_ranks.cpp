@@ -56,7 +56,6 @@ void Simulation<Dim, Real>::check_distributable() const {
   if (cfg_.time.mode == TimeStepping::PerParticle) not_yet.push_back("/time/stepping \"per-particle\"");
   if (cfg_.reorder_every > 0)
     not_yet.push_back("/neighbors/reorder_every " + std::to_string(cfg_.reorder_every) + " (only 0)");
-  if (cfg_.wall_motion.any()) not_yet.push_back("moving walls (a \"motion\" in /boundary)");
   if (bodies_.any()) not_yet.push_back("/bodies");
   if (cfg_.inflow.any()) not_yet.push_back("/emitters and /sinks");
   if (cfg_.wall_model == WallModel::VolumeMap) not_yet.push_back("/boundary/model \"volume-map\"");
@@ -106,6 +105,10 @@ void Simulation<Dim, Real>::rebuild_domain(bool first) {
   search_h_.assign(n, Real(0));
   bare_h_.assign(n, Real(0));
   rebuild_kind_lists();
+  // The moving walls this rank owns, at the clock's time: their positions and velocities (the same bits as
+  // those that travelled) and their accelerations, which do not travel.
+  set_moving_slots();
+  move_walls(time_);
   x_domain_ = p_.x;
 }
 
@@ -116,7 +119,9 @@ void Simulation<Dim, Real>::rebuild_domain(bool first) {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::update_domain() {
   const MaxDisplacementPass<Dim, Real> disp{view(), x_domain_.data()};
-  const Real d2 = domain_->max(reduce_max(fluid_, MaxValue<Real>{}, disp).value);
+  Real local = reduce_max(fluid_, MaxValue<Real>{}, disp).value;
+  if (moving_.any()) local = std::max(local, reduce_max(moving_.slots(), MaxValue<Real>{}, disp).value);
+  const Real d2 = domain_->max(local);
   const Real limit = Real(0.45) * domain_margin_;
   if (d2 <= limit * limit) {
     domain_->refresh(p_.x, p_.v);
