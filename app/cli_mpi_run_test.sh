@@ -62,6 +62,11 @@ case "$case_name" in
     # Moving walls: the gate (Adami's walls read the walls' accelerations) and the wave maker's paddle.
     same "gate" 3 dam-break-gate "${coarse[@]}" --until 0.2 --format csv --fps 20
     same "paddle" 2 wave-tank "${coarse[@]}" --until 0.3 --format csv --fps 10
+    # The paper's model: two phases with interface tension (the colour normals are shared), the Laplace
+    # drop (number density, tension), a paper dam break (its planes).
+    same "paper_two_phase" 3 two-phase --until 0.1 --format csv --fps 20
+    same "paper_laplace" 2 laplace-2d --until 0.03 --format csv --fps 100
+    same "paper_dam_break" 2 paper-dam-break-1 --until 0.1 --format csv --fps 20
     # A rebalance at every rebuild of the domain (threshold 1e-6) moves particles between ranks far more
     # often: still the same bytes, and the summary counts the rebalances.
     same "rebalance" 3 dam-break-2d "${coarse[@]}" --set /parallel/rebalance_threshold=1e-6 --until 0.15 \
@@ -89,7 +94,7 @@ case "$case_name" in
     err=$(ranks 2 run dam-break-2d-dfsph --out refused 2>&1)
     rc=$?
     [ "$rc" -ne 0 ] || fail "DFSPH on 2 ranks: exit 0"
-    [ "$(grep -c 'across MPI ranks steps WCSPH' <<<"$err")" = 1 ] || fail "DFSPH: not one message: $err"
+    [ "$(grep -c 'across MPI ranks steps WCSPH and the paper' <<<"$err")" = 1 ] || fail "DFSPH: not one message: $err"
     grep -q '/solver/model "dfsph"' <<<"$err" || fail "DFSPH: the key is not named: $err"
     [ ! -e refused ] || fail "DFSPH: an output folder was made"
     err=$(ranks 2 neighbors 2>&1)

@@ -109,6 +109,10 @@ class HostStepContext {
   [[nodiscard]] LeapFrogClock<Real>& clock() { return s_.clock_; }
   [[nodiscard]] Real agree_dt(Real dt) const { return s_.domain_ ? s_.domain_->min(dt) : dt; }
   void share_velocity() { s_.share_velocity(); }
+  template <class T>
+  void share(std::vector<T>& per_particle) {
+    if (s_.domain_) s_.domain_->refresh(per_particle);
+  }
   void forces_done() {
     s_.timings_.forces += sw_.ms();
     sw_.reset();
@@ -655,7 +659,8 @@ void Simulation<Dim, Real>::step_per_particle() {
   const auto tension = PaperTension::of(cfg_, any_tension_);
   timings_.force_evals += due_list_.size();
   if (tension.needs_normals()) timings_.normal_evals += normal_set_.size();
-  paper_normals_and_forces(cfg_, view(), due_list_, normal_set_, normal_, tension, wall_states_);
+  paper_normals_and_forces(cfg_, view(), due_list_, normal_set_, normal_, tension, wall_states_,
+                           [](const auto&) {});
   std::swap(p_.x, xs_);
   timings_.forces += sw.ms();
 

@@ -82,6 +82,8 @@ class DeviceStepContext {
   // One device is one rank: nothing to agree on or share.
   [[nodiscard]] Real agree_dt(Real dt) const { return dt; }
   void share_velocity() {}
+  template <class A>
+  void share(A& /*per_particle*/) {}
   // The Simulation counts a device step's work itself.
   void count_density(std::size_t) {}
   void count_forces(std::size_t) {}

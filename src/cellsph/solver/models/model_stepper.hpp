@@ -28,6 +28,7 @@
 //   clock()                        LeapFrogClock: the last step and whether the leap-frog has started
 //   forces_done()                  the end of the force phase (the timings' split)
 //   agree_dt(dt)                   the step every rank takes (a run across ranks: the smallest of theirs)
+//   share(array)                   the same for an array of the stepper's (one entry per particle)
 //   share_velocity()               after a pass changed velocities that a later pass reads of neighbours
 //                                  (a run across ranks: the halo copies refreshed; density() and
 //                                  wall_states() share their own outputs)

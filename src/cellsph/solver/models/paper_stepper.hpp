@@ -15,14 +15,16 @@ namespace cellsph {
 
 // The forces of `set`, after the colour normals of `normal_set` (the particles those forces read) when the
 // tension model needs them: every particle's normal is cleared first, in `normals`.
-template <int Dim, class Real, class Set, class NormalSet, class Normals>
+// `shared(normals)` runs between the two (a run across ranks: the halo copies' normals from their owners).
+template <int Dim, class Real, class Set, class NormalSet, class Normals, class Shared>
 void paper_normals_and_forces(const SolverConfig<Dim, Real>& cfg, ParticleView<Dim, Real> pv, const Set& set,
                               const NormalSet& normal_set, Normals& normals, PaperTension tension,
-                              bool wall_states) {
+                              bool wall_states, Shared&& shared) {
   if (tension.needs_normals()) {
     zero_array(normals, pv.n);
     pv.normal = normals.data();
     paper_normals(cfg, pv, normal_set);
+    shared(normals);
   }
   paper_forces(cfg, pv, set, tension, wall_states);
 }
@@ -39,7 +41,8 @@ class PaperStepper final : public ModelStepper<Dim, Real, Ctx> {
     const auto tension = PaperTension::of(cfg, c.any_tension());
     c.count_forces(c.fluid_count());
     if (tension.needs_normals()) c.count_normals(c.fluid_count());
-    paper_normals_and_forces(cfg, pv, c.fluid(), c.fluid(), normal_, tension, c.wall_states_on());
+    paper_normals_and_forces(cfg, pv, c.fluid(), c.fluid(), normal_, tension, c.wall_states_on(),
+                             [&](auto& normals) { c.share(normals); });
     c.forces_done();
 
     const Real dt = c.agree_dt(global_courant_dt(cfg, pv, c.fluid()));
