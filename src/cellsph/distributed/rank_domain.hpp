@@ -101,6 +101,11 @@ class RankDomain {
   // one exchange, each particle's values together.
   template <class... T>
   void refresh(std::vector<T>&... fields) const {
+    refresh(fields.data()...);
+  }
+  // The same for arrays given by their first element (a view's arrays).
+  template <class... T>
+  void refresh(T*... fields) const {
     const std::size_t ranks = plan_.send.size();
     std::vector<std::vector<std::byte>> to_rank(ranks);
     for (std::size_t r = 0; r < ranks; ++r)

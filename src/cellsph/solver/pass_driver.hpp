@@ -80,12 +80,20 @@ inline double merged_value(const std::vector<ExactSum>& partial) {
   return s.value();
 }
 
+// The same sum before its rounding: the accumulator, for a sum over MPI ranks (Communicator::sum).
 template <class Pass>
-double reduce_sum_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
+ExactSum reduce_sum_exact_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
   const std::size_t blocks = (n + kSumBlock - 1) / kSumBlock;
   std::vector<ExactSum> partial(blocks);
   parallel_for(blocks, [&](std::size_t b) { reduce_sum_block(idx, n, b, pass, partial[b]); });
-  return merged_value(partial);
+  ExactSum s;
+  for (const ExactSum& q : partial) s.merge(q);
+  return s;
+}
+
+template <class Pass>
+double reduce_sum_n(const std::uint32_t* idx, std::size_t n, const Pass& pass) {
+  return reduce_sum_exact_n(idx, n, pass).value();
 }
 
 // The number of indices of a set (a device set, device_driver.hpp, has its own overload).

@@ -67,6 +67,33 @@ SearchOptions step_search(SearchOptions o) {
   return o;
 }
 
+// What the implicit solvers' step shares beyond this rank's particles (models/dfsph.hpp's DfsphOneProcess
+// names each call): the halo copies of what a pass wrote, the solves' errors and the step over every rank.
+template <int Dim, class Real>
+struct RankExchange {
+  const distributed::RankDomain<Dim, Real>* domain;  // null: one process
+  std::size_t fluid;                                 // the fluid particles over every rank
+  void density(const ParticleView<Dim, Real>& pv) const {
+    if (domain) domain->refresh(pv.rho, pv.vol, pv.df_kappa, pv.df_mk);
+  }
+  void k(const ParticleView<Dim, Real>& pv) const {
+    if (domain) domain->refresh(pv.df_kappa, pv.df_mk);
+  }
+  void v(const ParticleView<Dim, Real>& pv) const {
+    if (domain) domain->refresh(pv.v, pv.df_mv);
+  }
+  [[nodiscard]] Real min(Real dt) const { return domain ? domain->min(dt) : dt; }
+  template <class Set, class Pass>
+  [[nodiscard]] double mean(const Set& set, const Pass& pass) const {
+    if (!domain) return DfsphOneProcess{}.mean(set, pass);
+    const IndexSet& s = set_of(set);
+    const ExactSum local = reduce_sum_exact_n(s.data(), s.size(), pass);
+    return domain->comm().sum(local).value() / static_cast<double>(std::max<std::size_t>(fluid, 1));
+  }
+  static const IndexSet& set_of(const IndexSet& s) { return s; }
+  static const IndexSet& set_of(const BalancedIndexSet& s) { return *s.set; }
+};
+
 }  // namespace
 
 // What a model's stepper (models/model_stepper.hpp) sees of the CPU backend: the Simulation's arrays, the
@@ -102,12 +129,20 @@ class HostStepContext {
   [[nodiscard]] bool any_tension() const { return s_.any_tension_; }
   [[nodiscard]] bool wall_states_on() const { return s_.wall_states_; }
   [[nodiscard]] Real particle_diameter() {
-    if (s_.particle_diameter_ == 0) s_.particle_diameter_ = dfsph_particle_diameter(s_.view(), s_.fluid_);
+    if (s_.particle_diameter_ == 0) {
+      s_.particle_diameter_ = dfsph_particle_diameter(s_.view(), s_.fluid_);
+      if (s_.domain_)  // over every rank (one that owns no fluid has none)
+        s_.particle_diameter_ =
+            s_.domain_->min(s_.fluid_.empty() ? std::numeric_limits<Real>::max() : s_.particle_diameter_);
+    }
     return s_.particle_diameter_;
   }
   [[nodiscard]] std::uint64_t step_number() const { return s_.steps_ + 1; }
   [[nodiscard]] LeapFrogClock<Real>& clock() { return s_.clock_; }
   [[nodiscard]] Real agree_dt(Real dt) const { return s_.domain_ ? s_.domain_->min(dt) : dt; }
+  [[nodiscard]] RankExchange<Dim, Real> implicit_exchange() const {
+    return {s_.domain_.get(), s_.fluid_count()};
+  }
   void share_velocity() { s_.share_velocity(); }
   template <class T>
   void share(std::vector<T>& per_particle) {

@@ -51,9 +51,9 @@ struct TravellingArrays {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::check_distributable() const {
   std::vector<std::string> not_yet;
-  if (cfg_.model != Model::Wcsph && cfg_.model != Model::PaperMultiphase)
-    not_yet.push_back("/solver/model \"" + std::string(model_name(cfg_.model)) +
-                      "\" (only \"wcsph\" and \"paper\")");
+  if (cfg_.model == Model::Iisph) not_yet.push_back("/solver/model \"iisph\" (wcsph, paper and dfsph run)");
+  if (cfg_.model == Model::Dfsph && cfg_.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient)
+    not_yet.push_back("/solver/dfsph/density_solver \"cg\" (\"jacobi\" runs)");
   if (cfg_.time.mode == TimeStepping::PerParticle) not_yet.push_back("/time/stepping \"per-particle\"");
   if (cfg_.reorder_every > 0)
     not_yet.push_back("/neighbors/reorder_every " + std::to_string(cfg_.reorder_every) + " (only 0)");
@@ -63,7 +63,7 @@ void Simulation<Dim, Real>::check_distributable() const {
   if (backend_ != Backend::Cpu) not_yet.push_back("--backend " + std::string(backend_name(backend_)));
   if (not_yet.empty()) return;
   std::ostringstream os;
-  os << "a run across MPI ranks steps WCSPH and the paper's model with global steps on the CPU so far "
+  os << "a run across MPI ranks steps WCSPH, DFSPH and the paper's model with global steps on the CPU so far "
         "(docs/distributed.md); this "
         "scene has ";
   for (std::size_t k = 0; k < not_yet.size(); ++k) os << (k ? "; " : "") << not_yet[k];
@@ -165,7 +165,7 @@ void Simulation<Dim, Real>::balance_domain() {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::share_density() {
   if (!domain_) return;
-  domain_->refresh(p_.rho, p_.p, vol_, prho2_);
+  domain_->refresh(p_.rho, p_.p, vol_, prho2_);  // (vectors: their arrays)
 }
 
 template <int Dim, class Real>

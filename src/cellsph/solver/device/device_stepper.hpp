@@ -81,6 +81,7 @@ class DeviceStepContext {
   }
   // One device is one rank: nothing to agree on or share.
   [[nodiscard]] Real agree_dt(Real dt) const { return dt; }
+  [[nodiscard]] DfsphOneProcess implicit_exchange() const { return {}; }
   void share_velocity() {}
   template <class A>
   void share(A& /*per_particle*/) {}

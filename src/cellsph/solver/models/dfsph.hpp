@@ -498,6 +498,27 @@ inline void implicit_check_solve(DfsphStats& st, const DfsphSolveResult& r, doub
 template <class Real>
 inline constexpr Real kDfsphDivergenceWarmScale = Real(0.5);
 
+// What a DFSPH step shares beyond its own particles: nothing in one process or on a device. A run across
+// ranks (solver/simulation.cpp's RankExchange) refreshes the halo copies of what a pass wrote and a later
+// pass reads of neighbours, and takes the errors' means and the step over every rank.
+struct DfsphOneProcess {
+  template <class Pv>
+  void density(const Pv&) const {}  // after the density pass: rho, vol, the warm start's k and m k
+  template <class Pv>
+  void k(const Pv&) const {}  // after a source pass: k and m k
+  template <class Pv>
+  void v(const Pv&) const {}  // after a kick: v and m v
+  template <class Real>
+  Real min(Real dt) const {
+    return dt;
+  }
+  // The mean of pass(i) over the set (a solve's error).
+  template <class Set, class Pass>
+  double mean(const Set& set, const Pass& pass) const {
+    return reduce_sum(set, pass) / static_cast<double>(std::max<std::size_t>(set_size(set), 1));
+  }
+};
+
 // The warm start's rule: warm_scale times the last step's k where the particle is compressed.
 template <class Real>
 DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool warm_start, Real warm_scale,
@@ -510,31 +531,37 @@ DfsphSourceRule<Real> dfsph_warm_rule(Real dt, bool density, Real* acc, bool war
 // written already (the density pass writes the mass density's divergence warm start). forces: the
 // non-pressure pass whose sums ride along every source pass that may be the solve's last (the velocities it
 // reads are then the solve's final ones; a pass that turns out not to be the last only wrote f early).
-template <int Dim, class Real, class Kernel, class Set>
+template <int Dim, class Real, class Kernel, class Set, class Ex = DfsphOneProcess>
 DfsphSolveResult dfsph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              bool density, Real* acc, double eta, int min_it, int max_it, bool warm_start,
                              Real warm_scale, std::uint32_t min_neighbors, bool number, bool mirror,
                              bool warm_k_set = false,
-                             const DfsphNonPressurePass<Dim, Real, Kernel>* forces = nullptr) {
+                             const DfsphNonPressurePass<Dim, Real, Kernel>* forces = nullptr,
+                             const Ex& ex = Ex{}) {
   const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number, mirror};
-  if (!warm_k_set)
+  if (!warm_k_set) {
     run_pass(set,
              DfsphSourcePass<Dim, Real, Kernel>{
                  pv, w, dfsph_warm_rule(dt, density, acc, warm_start, warm_scale, min_neighbors), number});
-  if (warm_start) run_pass(set, kick);
+    ex.k(pv);
+  }
+  if (warm_start) {
+    run_pass(set, kick);
+    ex.v(pv);
+  }
   const DfsphSourcePass<Dim, Real, Kernel> source{
       pv, w, DfsphSourceRule<Real>{dt, density, false, Real(0), acc, min_neighbors}, number};
-  const double n = static_cast<double>(std::max<std::size_t>(set_size(set), 1));
   DfsphSolveResult r;
   for (;;) {
     const bool may_end = r.iterations >= min_it || r.iterations >= max_it;
-    r.error = (forces != nullptr && may_end
-                   ? reduce_sum(set, DfsphSourceForcesPass<Dim, Real, Kernel>{source, *forces})
-                   : reduce_sum(set, source)) /
-              n;
+    r.error = forces != nullptr && may_end
+                  ? ex.mean(set, DfsphSourceForcesPass<Dim, Real, Kernel>{source, *forces})
+                  : ex.mean(set, source);
     if (!std::isfinite(r.error)) return r;
     if ((r.iterations >= min_it && r.error <= eta) || r.iterations >= max_it) return r;
+    ex.k(pv);
     run_pass(set, kick);
+    ex.v(pv);
     ++r.iterations;
   }
 }
@@ -607,9 +634,10 @@ DfsphNonPressurePass<Dim, Real, Kernel> implicit_forces_pass(const SolverConfig<
 // particle). `all` ranges over every particle, walls too (their df_mv and df_mk). Returns dt. Throws
 // SimulationError when a solve's error is not finite. `step` is the number of the step being taken
 // (1-based), for messages.
-template <int Dim, class Real, class Set, class All>
+// `ex`: what the step shares beyond its particles (DfsphOneProcess; a run across ranks: RankExchange).
+template <int Dim, class Real, class Set, class All, class Ex = DfsphOneProcess>
 Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& fluid,
-                const All& all, Real diameter, DfsphStats& st, std::uint64_t step) {
+                const All& all, Real diameter, DfsphStats& st, std::uint64_t step, const Ex& ex = Ex{}) {
   const Real h = cfg.support;
   // A full neighbourhood holds about the support's volume over the particle volume; the divergence solve
   // leaves particles with fewer than 60% of that alone (SPlisHSPlasH's 20 of about 33 in 3D).
@@ -628,6 +656,8 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     dt = implicit_density_and_step(cfg, pv, fluid, all, w, diameter,
                                    dfsph_warm_rule(Real(0), false, pv.df_kappa_v, cfg.dfsph.warm_start,
                                                    kDfsphDivergenceWarmScale<Real>, min_neighbors));
+    ex.density(pv);
+    dt = ex.min(dt);
     st.ms_factor += sw.ms();
     sw.reset();
 
@@ -636,12 +666,13 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     const DfsphSolveResult div =
         dfsph_solve(pv, fluid, w, dt, false, pv.df_kappa_v, eta_divergence, 1, cfg.dfsph.max_iterations,
                     cfg.dfsph.warm_start, kDfsphDivergenceWarmScale<Real>, min_neighbors, number, mirror,
-                    !number, &forces);
+                    !number, &forces, ex);
     implicit_check_solve(st, div, eta_divergence, step, double(dt), "DFSPH divergence-free", "sweeps");
     st.ms_divergence += sw.ms();
     sw.reset();
 
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
+    ex.v(pv);
     st.ms_nonpressure += sw.ms();
     sw.reset();
 
@@ -652,7 +683,8 @@ Real dfsph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
                              cfg.dfsph.warm_start ? cfg.dfsph.warm_start_scale : Real(0), mirror)
             : dfsph_solve(pv, fluid, w, dt, true, pv.prho2, eta_density, cfg.dfsph.min_iterations,
                           cfg.dfsph.max_iterations, cfg.dfsph.warm_start, cfg.dfsph.warm_start_scale,
-                          min_neighbors, number, mirror);
+                          min_neighbors, number, mirror, false,
+                          static_cast<const DfsphNonPressurePass<Dim, Real, K>*>(nullptr), ex);
     implicit_check_solve(st, den, eta_density, step, double(dt), "DFSPH constant-density", "sweeps");
     st.ms_density += sw.ms();
     sw.reset();

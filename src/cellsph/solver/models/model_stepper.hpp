@@ -29,6 +29,7 @@
 //   forces_done()                  the end of the force phase (the timings' split)
 //   agree_dt(dt)                   the step every rank takes (a run across ranks: the smallest of theirs)
 //   share(array)                   the same for an array of the stepper's (one entry per particle)
+//   implicit_exchange()            the implicit solvers' exchanges (models/dfsph.hpp, DfsphOneProcess)
 //   share_velocity()               after a pass changed velocities that a later pass reads of neighbours
 //                                  (a run across ranks: the halo copies refreshed; density() and
 //                                  wall_states() share their own outputs)
