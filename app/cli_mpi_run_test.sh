@@ -72,6 +72,8 @@ case "$case_name" in
     same "dfsph" 4 dam-break-2d-dfsph "${coarse[@]}" --until 0.2 --format csv --fps 20
     same "dfsph_number" 2 dam-break-2d-dfsph "${coarse[@]}" --set /solver/density=number --until 0.1 \
       --format csv --fps 20
+    same "iisph" 3 dam-break-2d-dfsph "${coarse[@]}" --set /solver/model=iisph --set /solver/dfsph=null \
+      --until 0.1 --format csv --fps 20
     same "dfsph_3d" 3 dam-break-3d-dfsph --set /neighbors/reorder_every=0 --set /spacing=0.05 \
       --set /solver/support=0.1 --until 0.06 --format csv --fps 50
     # A rebalance at every rebuild of the domain (threshold 1e-6) moves particles between ranks far more
@@ -98,15 +100,15 @@ case "$case_name" in
     fi
     ;;
   refusals)
-    # The 3D DFSPH dam break reorders its arrays (the ranks keep the id order); IISPH: both keys in one
-    # message.
-    err=$(ranks 2 run dam-break-3d-dfsph --set /solver/model=iisph --set /solver/dfsph=null --out refused 2>&1)
+    # The 3D DFSPH dam break reorders its arrays (the ranks keep the id order) and here takes the CG density
+    # solve: both keys in one message.
+    err=$(ranks 2 run dam-break-3d-dfsph --set /solver/dfsph/density_solver=cg --out refused 2>&1)
     rc=$?
-    [ "$rc" -ne 0 ] || fail "IISPH on 2 ranks: exit 0"
-    [ "$(grep -c 'across MPI ranks steps WCSPH, DFSPH and the paper' <<<"$err")" = 1 ] || fail "not one message: $err"
-    grep -q '/solver/model "iisph"' <<<"$err" || fail "the model is not named: $err"
+    [ "$rc" -ne 0 ] || fail "CG on 2 ranks: exit 0"
+    [ "$(grep -c 'across MPI ranks runs every model' <<<"$err")" = 1 ] || fail "not one message: $err"
+    grep -q '/solver/dfsph/density_solver "cg"' <<<"$err" || fail "the solver is not named: $err"
     grep -q '/neighbors/reorder_every 25' <<<"$err" || fail "the reorder is not named: $err"
-    [ ! -e refused ] || fail "IISPH: an output folder was made"
+    [ ! -e refused ] || fail "CG: an output folder was made"
     err=$(ranks 2 neighbors 2>&1)
     [ "$(grep -c 'only `cellsph run` runs across ranks' <<<"$err")" = 1 ] || fail "neighbors: $err"
     out=$(ranks 2 doctor)

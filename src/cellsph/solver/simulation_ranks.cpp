@@ -51,7 +51,6 @@ struct TravellingArrays {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::check_distributable() const {
   std::vector<std::string> not_yet;
-  if (cfg_.model == Model::Iisph) not_yet.push_back("/solver/model \"iisph\" (wcsph, paper and dfsph run)");
   if (cfg_.model == Model::Dfsph && cfg_.dfsph.density_solver == DfsphDensitySolver::ConjugateGradient)
     not_yet.push_back("/solver/dfsph/density_solver \"cg\" (\"jacobi\" runs)");
   if (cfg_.time.mode == TimeStepping::PerParticle) not_yet.push_back("/time/stepping \"per-particle\"");
@@ -63,9 +62,8 @@ void Simulation<Dim, Real>::check_distributable() const {
   if (backend_ != Backend::Cpu) not_yet.push_back("--backend " + std::string(backend_name(backend_)));
   if (not_yet.empty()) return;
   std::ostringstream os;
-  os << "a run across MPI ranks steps WCSPH, DFSPH and the paper's model with global steps on the CPU so far "
-        "(docs/distributed.md); this "
-        "scene has ";
+  os << "a run across MPI ranks runs every model with global steps on the CPU, but not yet "
+        "(docs/distributed.md) what this scene has: ";
   for (std::size_t k = 0; k < not_yet.size(); ++k) os << (k ? "; " : "") << not_yet[k];
   os << ". Run it as one process (without mpirun), or change those keys with --set";
   throw InputError(os.str());

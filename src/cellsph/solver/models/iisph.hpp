@@ -75,22 +75,26 @@ struct IisphUpdatePass {
 
 // The pressure solve (step 4): the warm start and its kick, then iterations until the average error is at
 // most eta (relative) after at least min_it of them, or max_it were made.
-template <int Dim, class Real, class Kernel, class Set>
+// `ex`: what the solve shares beyond its particles (models/dfsph.hpp, DfsphOneProcess).
+template <int Dim, class Real, class Kernel, class Set, class Ex = DfsphOneProcess>
 DfsphSolveResult iisph_solve(const ParticleView<Dim, Real>& pv, const Set& set, const Kernel& w, Real dt,
                              double eta, int min_it, int max_it, Real warm_scale, Real omega, bool number,
-                             bool mirror) {
+                             bool mirror, const Ex& ex = Ex{}) {
   Real* acc = pv.prho2;
   run_pass(set, IisphWarmStartPass<Dim, Real>{pv, warm_scale, acc});
+  ex.k(pv);
   const DfsphPressureKickPass<Dim, Real, Kernel> kick{pv, w, dt, acc, number, mirror};
   run_pass(set, kick);
+  ex.v(pv);
   const IisphUpdatePass<Dim, Real, Kernel> update{pv, w, dt, omega, acc, number};
-  const double n = static_cast<double>(std::max<std::size_t>(set_size(set), 1));
   DfsphSolveResult r;
   for (;;) {
-    r.error = reduce_sum(set, update) / n;
+    r.error = ex.mean(set, update);
     if (!std::isfinite(r.error)) return r;
     if ((r.iterations >= min_it && r.error <= eta) || r.iterations >= max_it) return r;
+    ex.k(pv);
     run_pass(set, kick);
+    ex.v(pv);
     ++r.iterations;
   }
 }
@@ -98,9 +102,9 @@ DfsphSolveResult iisph_solve(const ParticleView<Dim, Real>& pv, const Set& set, 
 // One IISPH step of the particles of `fluid` (dfsph_step's contract: rows cut to h, the DFSPH arrays sized
 // for every particle, `all` over every particle). Returns dt; throws SimulationError when the solve's error
 // is not finite. Its statistics are DFSPH's (no divergence solve: those stay 0).
-template <int Dim, class Real, class Set, class All>
+template <int Dim, class Real, class Set, class All, class Ex = DfsphOneProcess>
 Real iisph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real>& pv, const Set& fluid,
-                const All& all, Real diameter, DfsphStats& st, std::uint64_t step) {
+                const All& all, Real diameter, DfsphStats& st, std::uint64_t step, const Ex& ex = Ex{}) {
   const bool number = cfg.density == DensityFormulation::Number;
   const bool mirror = cfg.dfsph.mirror_walls();
   Real dt = 0;
@@ -110,18 +114,22 @@ Real iisph_step(const SolverConfig<Dim, Real>& cfg, const ParticleView<Dim, Real
     dt = implicit_density_and_step(
         cfg, pv, fluid, all, w, diameter,
         dfsph_warm_rule(Real(0), false, pv.df_kappa_v, false, Real(0), std::uint32_t{0}));
+    ex.density(pv);
+    dt = ex.min(dt);
     st.ms_factor += sw.ms();
     sw.reset();
 
     run_pass(fluid, implicit_forces_pass(cfg, pv, w));
     run_pass(fluid, DfsphKickPass<Dim, Real>{pv, dt});
+    ex.v(pv);
     st.ms_nonpressure += sw.ms();
     sw.reset();
 
     const double eta = double(cfg.dfsph.max_density_error) / 100;
-    const DfsphSolveResult r = iisph_solve(
-        pv, fluid, w, dt, eta, cfg.dfsph.min_iterations, cfg.dfsph.max_iterations,
-        cfg.dfsph.warm_start ? cfg.dfsph.warm_start_scale : Real(0), cfg.dfsph.relaxation, number, mirror);
+    const DfsphSolveResult r =
+        iisph_solve(pv, fluid, w, dt, eta, cfg.dfsph.min_iterations, cfg.dfsph.max_iterations,
+                    cfg.dfsph.warm_start ? cfg.dfsph.warm_start_scale : Real(0), cfg.dfsph.relaxation, number,
+                    mirror, ex);
     implicit_check_solve(st, r, eta, step, double(dt), "IISPH pressure", "iterations");
     st.ms_density += sw.ms();
     sw.reset();

@@ -38,8 +38,8 @@ class IisphStepper final : public ImplicitPressureStepper<Dim, Real, Ctx> {
 
   Real advance(Ctx& c) override {
     const ParticleView<Dim, Real> pv = this->prepare(c);
-    const Real dt =
-        iisph_step(c.cfg(), pv, c.fluid_by_pairs(), c.all(), this->diameter_, this->stats_, c.step_number());
+    const Real dt = iisph_step(c.cfg(), pv, c.fluid_by_pairs(), c.all(), this->diameter_, this->stats_,
+                               c.step_number(), c.implicit_exchange());
     c.forces_done();
     return dt;
   }
