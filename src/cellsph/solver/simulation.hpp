@@ -212,8 +212,8 @@ class Simulation {
   // curve, distributed/rank_domain.hpp) and the copies its rows need; each step then moves particles to
   // their owners and exchanges what the passes share, and every particle gets the bits of the
   // single-process run (`neighbors.reorder_every` 0: the id order). Throws InputError, naming the key,
-  // for what the step across ranks does not run yet (only WCSPH and the paper model, global steps on the CPU,
-  // without floating bodies, emitters and reordering). With one rank: nothing changes.
+  // for what the step across ranks does not run yet (global steps on the CPU, every model but DFSPH's CG
+  // solve, without volume-map walls, floating bodies, emitters and reordering). One rank: nothing changes.
   void distribute(const distributed::Communicator& comm);
   [[nodiscard]] bool distributed() const { return domain_ != nullptr; }
   // A run across ranks: its ranks, rebuilds of the domain, rebalances and the work's imbalance (the same on
