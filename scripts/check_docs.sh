@@ -2,7 +2,9 @@
 # Runs every `cellsph` command shown in README.md and docs/*.md, so the docs stay true.
 # Usage: scripts/check_docs.sh BUILD_DIR
 # Commands are taken from fenced code blocks: lines starting with build/release/cellsph,
-# build/cellsph or PYTHONPATH=build/release/python (the Python module; comments after '#' dropped).
+# build/cellsph, PYTHONPATH=build/release/python (the Python module) or `mpirun -np N [--oversubscribe]
+# build/release/cellsph` (runs across ranks: oversubscribed, and allowed as root as CI runs); comments
+# after '#' dropped.
 # They run in a scratch folder that links the repo's scenes/, scripts/ and the given build, after a small
 # points.csv is made for the `neighbors` examples.
 # Long runs are shortened by SHORTEN (appended to `run` commands that have no --until/--steps),
@@ -34,6 +36,10 @@ while IFS= read -r line; do
     # Google Benchmark: one short run of each benchmark (the later flags win), to check the filter and the code.
     build/release/cellsph_bench*|build/cellsph_bench*) cmd="$cmd --benchmark_min_time=0.01 --benchmark_repetitions=1" ;;
   esac
+  case "$cmd" in
+    mpirun\ *--oversubscribe*) cmd="OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 $cmd" ;;
+    mpirun\ *) cmd="OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe ${cmd#mpirun }" ;;
+  esac
   # Tour runs are long at full length; keep their options but cap the simulated time.
   cmd="$(echo "$cmd" | sed -E 's/--until ([0-9.]+)/--until 0.02/')"
   n=$((n + 1))
@@ -41,6 +47,6 @@ while IFS= read -r line; do
   if ! bash -c "$cmd" </dev/null >"$scratch/out.txt" 2>&1; then
     echo "FAILED: $cmd"; tail -5 "$scratch/out.txt"; fail=$((fail + 1))
   fi
-done < <(awk '/^```/{inb=!inb; next} inb && /^(build\/release\/cellsph|build\/cellsph|PYTHONPATH=build\/release\/python )/' "$root/README.md" "$root"/docs/*.md)
+done < <(awk '/^```/{inb=!inb; next} inb && /^(build\/release\/cellsph|build\/cellsph|PYTHONPATH=build\/release\/python |mpirun -np [0-9]+ (--oversubscribe )?build\/release\/cellsph)/' "$root/README.md" "$root"/docs/*.md)
 echo "docs: $((n - fail)) passed, $fail failed"
 [ "$fail" -eq 0 ]
