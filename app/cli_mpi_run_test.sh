@@ -76,6 +76,11 @@ case "$case_name" in
       --until 0.1 --format csv --fps 20
     same "dfsph_3d" 3 dam-break-3d-dfsph --set /neighbors/reorder_every=0 --set /spacing=0.05 \
       --set /solver/support=0.1 --until 0.06 --format csv --fps 50
+    # A floating box: its particles' forces summed in id order on every rank, the same body stepped on each
+    # (bodies.csv too); long enough that the curve's cut crosses the box.
+    same "floating" 3 floating-box --set /spacing=0.02 --set /solver/support=0.04 --until 0.3 --format csv \
+      --fps 10
+    [ -s np3_floating/bodies.csv ] || fail "floating: no bodies.csv"
     # A rebalance at every rebuild of the domain (threshold 1e-6) moves particles between ranks far more
     # often: still the same bytes, and the summary counts the rebalances.
     same "rebalance" 3 dam-break-2d "${coarse[@]}" --set /parallel/rebalance_threshold=1e-6 --until 0.15 \

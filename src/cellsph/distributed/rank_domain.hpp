@@ -153,6 +153,13 @@ class RankDomain {
     return std::string(reinterpret_cast<const char*>(in.data()), in.size());
   }
 
+  // Every rank's bytes, concatenated in rank order, on every rank.
+  [[nodiscard]] std::vector<std::byte> all_gather(const std::vector<std::byte>& mine) const {
+    std::vector<std::vector<std::byte>> to_rank(static_cast<std::size_t>(comm_.size()), mine);
+    std::vector<std::size_t> from;
+    return comm_.all_to_all(to_rank, from);
+  }
+
   // Every rank's owned particles, on rank 0 in id order (the other ranks' `out` ends empty).
   template <class Soa>
   void gather_to_root(const Soa& p, Soa& out) const {

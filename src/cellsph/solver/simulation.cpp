@@ -319,7 +319,10 @@ void Simulation<Dim, Real>::build_wall_map() {
 
 template <int Dim, class Real>
 void Simulation<Dim, Real>::set_body_slots(bool place) {
-  bodies_.set_slots(p_.id, boundary_, p_.size());
+  if (domain_)
+    bodies_.set_slots(p_.id, local_walls_, p_.size(), &domain_->owned());
+  else
+    bodies_.set_slots(p_.id, boundary_, p_.size());
   if (!bodies_.any()) return;
   if (wall_a_.size() != p_.size()) wall_a_.assign(p_.size(), V{});
   // Their rows hold their fluid neighbours (within h: the reaction) and the walls they touch.
@@ -338,6 +341,7 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::compute_body_loads(const ParticleView<Dim, Real>& pv) {
   with_wcsph_forces_pass(cfg_, pv, any_tension_, wall_states_,
                          [&](const auto& pass) { bodies_.compute_loads(pv, pass); });
+  if (domain_) share_body_loads();
 }
 
 template <int Dim, class Real>
@@ -451,7 +455,8 @@ void Simulation<Dim, Real>::compute_neighbors(bool boundary_rows) {
     Real d2 = reduce_max(row_fluid(), MaxValue<Real>{}, disp).value;
     if (moving_.any()) d2 = std::max(d2, reduce_max(moving_.slots(), MaxValue<Real>{}, disp).value);
     // Across ranks the moving walls' halo copies too (a wall at rest has not moved).
-    if (domain_ && moving_.any()) d2 = std::max(d2, reduce_max(local_walls_, MaxValue<Real>{}, disp).value);
+    if (domain_ && (moving_.any() || bodies_.any()))
+      d2 = std::max(d2, reduce_max(local_walls_, MaxValue<Real>{}, disp).value);
     if (bodies_.any()) d2 = std::max(d2, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
     const Real limit = Real(0.45) * skin_;
     if (d2 <= limit * limit) {

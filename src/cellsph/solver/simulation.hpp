@@ -213,7 +213,7 @@ class Simulation {
   // their owners and exchanges what the passes share, and every particle gets the bits of the
   // single-process run (`neighbors.reorder_every` 0: the id order). Throws InputError, naming the key,
   // for what the step across ranks does not run yet (global steps on the CPU, every model but DFSPH's CG
-  // solve, without volume-map walls, floating bodies, emitters and reordering). One rank: nothing changes.
+  // solve, without volume-map walls, emitters and reordering). One rank: nothing changes.
   void distribute(const distributed::Communicator& comm);
   [[nodiscard]] bool distributed() const { return domain_ != nullptr; }
   // A run across ranks: its ranks, rebuilds of the domain, rebalances and the work's imbalance (the same on
@@ -307,6 +307,9 @@ class Simulation {
   void share_density();
   void share_wall_states();
   void share_velocity();
+  // Floating bodies across ranks: every rank's body particles' forces summed in id order on every rank (the
+  // single-process sums), so that each rank steps the same bodies.
+  void share_body_loads();
   [[nodiscard]] std::string unstable_message(std::int64_t first) const;
 
   Config cfg_;

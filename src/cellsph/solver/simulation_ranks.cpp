@@ -4,6 +4,7 @@
 // reads are refreshed on the copies right after it (share_*); the step size and the stability check are
 // agreed over the ranks (simulation.cpp's HostStepContext::agree_dt and check_state).
 #include <algorithm>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -56,7 +57,6 @@ void Simulation<Dim, Real>::check_distributable() const {
   if (cfg_.time.mode == TimeStepping::PerParticle) not_yet.push_back("/time/stepping \"per-particle\"");
   if (cfg_.reorder_every > 0)
     not_yet.push_back("/neighbors/reorder_every " + std::to_string(cfg_.reorder_every) + " (only 0)");
-  if (bodies_.any()) not_yet.push_back("/bodies");
   if (cfg_.inflow.any()) not_yet.push_back("/emitters and /sinks");
   if (cfg_.wall_model == WallModel::VolumeMap) not_yet.push_back("/boundary/model \"volume-map\"");
   if (backend_ != Backend::Cpu) not_yet.push_back("--backend " + std::string(backend_name(backend_)));
@@ -81,8 +81,10 @@ void Simulation<Dim, Real>::distribute(const distributed::Communicator& comm) {
   // step: on the default scene on 2 ranks, a margin of 0.15 h rebuilt every 3-4 steps and took 10-20%
   // longer than 0.5 h (docs/distributed.md).
   domain_margin_ = std::max(skin_, cfg_.support / 2);
-  domain_ = std::make_unique<distributed::RankDomain<Dim, Real>>(
-      comm, lo, double(cfg_.support) + double(domain_margin_));
+  // The rows reach the support, and a floating body's particles their contact distance.
+  const double reach =
+      std::max(double(cfg_.support), bodies_.any() ? cfg_.rigid_bodies.contact_distance : 0.0);
+  domain_ = std::make_unique<distributed::RankDomain<Dim, Real>>(comm, lo, reach + double(domain_margin_));
   global_fluid_count_ = fluid_count_;
   rank_stats_ = RankStats{};
   rank_stats_.ranks = comm.size();
@@ -104,11 +106,16 @@ void Simulation<Dim, Real>::rebuild_domain(bool first) {
   rho0_.assign(n, Real(0));
   search_h_.assign(n, Real(0));
   bare_h_.assign(n, Real(0));
+  // The per-slot arrays a step writes before it reads them, but only for some kinds: as a single-process
+  // run holds them for particles no pass writes (0), not another particle's value left in the slot.
+  for (auto* a : {&vol_, &prho2_}) a->assign(n, Real(0));
+  if (!wall_v_.empty()) wall_v_.assign(n, V{});
   rebuild_kind_lists();
   // The moving walls this rank owns, at the clock's time: their positions and velocities (the same bits as
   // those that travelled) and their accelerations, which do not travel.
   set_moving_slots();
   move_walls(time_);
+  set_body_slots(true);  // their search radius, and placed again from the same states (the same bits)
   x_domain_ = p_.x;
 }
 
@@ -121,6 +128,7 @@ void Simulation<Dim, Real>::update_domain() {
   const MaxDisplacementPass<Dim, Real> disp{view(), x_domain_.data()};
   Real local = reduce_max(fluid_, MaxValue<Real>{}, disp).value;
   if (moving_.any()) local = std::max(local, reduce_max(moving_.slots(), MaxValue<Real>{}, disp).value);
+  if (bodies_.any()) local = std::max(local, reduce_max(bodies_.slots(), MaxValue<Real>{}, disp).value);
   const Real d2 = domain_->max(local);
   const Real limit = Real(0.45) * domain_margin_;
   if (d2 <= limit * limit) {
@@ -178,6 +186,37 @@ void Simulation<Dim, Real>::share_velocity() {
 }
 
 template <int Dim, class Real>
+void Simulation<Dim, Real>::share_body_loads() {
+  struct Entry {
+    std::uint32_t id;
+    std::int32_t body;
+    Vec<Dim, double> f;
+    V x;
+  };
+  const auto& slots = bodies_.slots();
+  const auto& f = bodies_.forces();
+  const auto& body = bodies_.body_of_body_particle();
+  std::vector<std::byte> mine(slots.size() * sizeof(Entry));
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    const Entry e{p_.id[slots[k]], body[k], f[k], p_.x[slots[k]]};
+    std::memcpy(mine.data() + k * sizeof(Entry), &e, sizeof(Entry));
+  }
+  const std::vector<std::byte> all = domain_->all_gather(mine);
+  std::vector<Entry> entries(all.size() / sizeof(Entry));
+  std::memcpy(entries.data(), all.data(), entries.size() * sizeof(Entry));
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.id < b.id; });
+  std::vector<std::int32_t> bodies(entries.size());
+  std::vector<Vec<Dim, double>> forces(entries.size());
+  std::vector<V> xs(entries.size());
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    bodies[k] = entries[k].body;
+    forces[k] = entries[k].f;
+    xs[k] = entries[k].x;
+  }
+  bodies_.sum_loads_of(bodies, forces, xs);
+}
+
+template <int Dim, class Real>
 void Simulation<Dim, Real>::gather_for_output() {
   if (!domain_) return;
   TravellingArrays<Dim, Real> arrays(p_, state_, wall_self_rho_);
@@ -196,6 +235,7 @@ void Simulation<Dim, Real>::gather_for_output() {
   template void Simulation<D, R>::share_density();                              \
   template void Simulation<D, R>::share_wall_states();                          \
   template void Simulation<D, R>::share_velocity();                             \
+  template void Simulation<D, R>::share_body_loads();                           \
   template void Simulation<D, R>::gather_for_output();
 CELLSPH_SIMULATION_RANKS(2, float)
 CELLSPH_SIMULATION_RANKS(2, double)

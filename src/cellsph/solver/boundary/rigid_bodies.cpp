@@ -93,7 +93,8 @@ void RigidBodySystem<Dim, Real>::init(const RigidBodies& cfg, const std::vector<
 
 template <int Dim, class Real>
 void RigidBodySystem<Dim, Real>::set_slots(const std::vector<std::uint32_t>& id,
-                                           const std::vector<std::uint32_t>& boundary, std::size_t n) {
+                                           const std::vector<std::uint32_t>& boundary, std::size_t n,
+                                           const std::vector<std::uint8_t>* owned) {
   slot_.clear();
   body_.clear();
   r0_.clear();
@@ -102,10 +103,11 @@ void RigidBodySystem<Dim, Real>::set_slots(const std::vector<std::uint32_t>& id,
   for (const std::uint32_t b : boundary) {
     const std::int32_t body = body_of_id_[id[b]];
     if (body < 0) continue;
+    body_of_slot_[b] = body;
+    if (owned && !(*owned)[b]) continue;
     slot_.push_back(b);
     body_.push_back(body);
     r0_.push_back(r0_of_id_[id[b]]);
-    body_of_slot_[b] = body;
   }
 }
 

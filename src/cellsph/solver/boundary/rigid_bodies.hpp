@@ -215,9 +215,11 @@ class RigidBodySystem {
             const std::vector<std::uint32_t>& id, double sound_speed);
   // The contact spring's angular frequency in use [rad/s].
   [[nodiscard]] double contact_frequency() const { return frequency_; }
-  // The slots of the body particles (ascending among `boundary`), from the particles' ids.
+  // The slots of the body particles (ascending among `boundary`), from the particles' ids. `owned` (a run
+  // across ranks: per slot, 1 for a particle this rank owns): slots() only the owned ones, body_of_slot()
+  // every body particle of `boundary` (the contact pass tells a halo copy's body from a wall).
   void set_slots(const std::vector<std::uint32_t>& id, const std::vector<std::uint32_t>& boundary,
-                 std::size_t n);
+                 std::size_t n, const std::vector<std::uint8_t>* owned = nullptr);
   // Replaces the states (a checkpoint's); InputError naming `source` when there are not as many as bodies
   // or one is not finite or its quaternion not of unit length.
   void set_states(std::vector<RigidBodyState> states, const std::string& source);
@@ -229,8 +231,19 @@ class RigidBodySystem {
   // passes' sum) and its position x[k].
   void sum_loads(const std::vector<Vec<Dim, double>>& f, const std::vector<V>& x) {
     f_ = f;
-    add_loads([&](std::size_t k) { return x[k]; });
+    add_loads(
+        f_.size(), [&](std::size_t k) { return body_[k]; }, [&](std::size_t k) { return x[k]; });
   }
+  // The same sums over lists given whole (a run across ranks: every rank's body particles, in id order):
+  // per body particle its body, force and position.
+  void sum_loads_of(const std::vector<std::int32_t>& body, const std::vector<Vec<Dim, double>>& f,
+                    const std::vector<V>& x) {
+    f_ = f;
+    add_loads(
+        f_.size(), [&](std::size_t k) { return body[k]; }, [&](std::size_t k) { return x[k]; });
+  }
+  // Per body particle of slots(), the force of the last compute_loads.
+  [[nodiscard]] const std::vector<Vec<Dim, double>>& forces() const { return f_; }
   // The contact pass over the body particles slot[k] with this system's constants, over the given arrays
   // (host or device: slot, body_of_slot, mass_per_particle as those below).
   [[nodiscard]] BodyContactPass<Dim, Real> contact_pass(const ParticleView<Dim, Real>& pv,
@@ -262,9 +275,10 @@ class RigidBodySystem {
   [[nodiscard]] std::array<double, 3> momentum() const;
 
  private:
-  // loads() from f_ and the body particles' positions x_of(k), serially in slot order.
-  template <class PositionOf>
-  void add_loads(const PositionOf& x_of);
+  // loads() from f_ and the body particles' bodies body_of(k) and positions x_of(k), k < count, serially
+  // in k's order.
+  template <class BodyOf, class PositionOf>
+  void add_loads(std::size_t count, const BodyOf& body_of, const PositionOf& x_of);
 
   const RigidBodies* cfg_ = nullptr;
   double frequency_ = 0;
@@ -299,16 +313,18 @@ void RigidBodySystem<Dim, Real>::compute_loads(const ParticleView<Dim, Real>& pv
   run_pass(slot_.size(), BodyReactionPass<Dim, Real, ForcesPass>{pv, forces, slot_.data(), f_.data()});
   run_pass(slot_.size(),
            contact_pass(pv, slot_.data(), body_of_slot_.data(), mass_per_particle_.data(), f_.data()));
-  add_loads([&](std::size_t k) { return pv.x[slot_[k]]; });
+  add_loads(
+      slot_.size(), [&](std::size_t k) { return body_[k]; }, [&](std::size_t k) { return pv.x[slot_[k]]; });
 }
 
 template <int Dim, class Real>
-template <class PositionOf>
-void RigidBodySystem<Dim, Real>::add_loads(const PositionOf& x_of) {
+template <class BodyOf, class PositionOf>
+void RigidBodySystem<Dim, Real>::add_loads(std::size_t count, const BodyOf& body_of, const PositionOf& x_of) {
   loads_.assign(states_.size(), RigidBodyLoad{});
-  for (std::size_t k = 0; k < slot_.size(); ++k) {
-    RigidBodyLoad& l = loads_[static_cast<std::size_t>(body_[k])];
-    const RigidBodyState& s = states_[static_cast<std::size_t>(body_[k])];
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto b = static_cast<std::size_t>(body_of(k));
+    RigidBodyLoad& l = loads_[b];
+    const RigidBodyState& s = states_[b];
     double f[3] = {0, 0, 0}, r[3] = {0, 0, 0}, t[3];
     for (int a = 0; a < Dim; ++a) {
       f[a] = f_[k][a];
