@@ -79,7 +79,7 @@ void Simulation<Dim, Real>::distribute(const distributed::Communicator& comm) {
   // The halo's margin beyond the support: half of it (or the Verlet skin, if longer). A wider margin keeps
   // the domain for more steps (a rebuild moves and sorts every particle) and refreshes more copies each
   // step: on the default scene on 2 ranks, a margin of 0.15 h rebuilt every 3-4 steps and took 10-20%
-  // longer than 0.5 h (docs/distributed.md).
+  // longer than 0.5 h (docs/benchmarks.md, "A run across MPI ranks").
   domain_margin_ = std::max(skin_, cfg_.support / 2);
   // The rows reach the support, and a floating body's particles their contact distance.
   const double reach =
@@ -97,7 +97,7 @@ template <int Dim, class Real>
 void Simulation<Dim, Real>::rebuild_domain(bool first) {
   TravellingArrays<Dim, Real> arrays(p_, state_, wall_self_rho_);
   // The start's split weighs a fluid particle as four wall particles (its row's passes against a wall's
-  // state pass); every later step keeps those cuts.
+  // state pass); later rebuilds keep the cuts unless balance_domain cut again by the measured work.
   if (first)
     domain_->start(arrays, [&](std::size_t i) { return p_.kind[i] == kFluidKind ? 4 : 1; });
   else
