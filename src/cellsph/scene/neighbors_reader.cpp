@@ -27,7 +27,7 @@ void read_parallel(JsonReader& r, SolverConfig<Dim, Real>& cfg) {
   pr.finish();
 }
 
-#define CELLSPH_NEIGHBORS_INSTANTIATE(D, R) \
+#define CELLSPH_NEIGHBORS_INSTANTIATE(D, R)                             \
   template void read_neighbors<D, R>(JsonReader&, SolverConfig<D, R>&); \
   template void read_parallel<D, R>(JsonReader&, SolverConfig<D, R>&);
 CELLSPH_NEIGHBORS_INSTANTIATE(2, float)
