@@ -120,26 +120,33 @@ HaloPlan add_halo(Soa& p, const std::vector<std::vector<std::size_t>>& sends, co
   return plan;
 }
 
-// The halo copies of one field brought up to date from their owners (after a pass that wrote it for the
-// owned particles), one all-to-all exchange of that field alone.
-template <class T>
-void refresh_halo(std::vector<T>& field, const HaloPlan& plan, const Communicator& comm) {
-  static_assert(std::is_trivially_copyable_v<T>, "a field sent to another rank must be trivially copyable");
+// The halo copies of some fields (each given by its first element, one entry per slot) brought up to date
+// from their owners, after a pass wrote them for the owned particles: one all-to-all exchange, each
+// particle's values together.
+template <class... T>
+void refresh_halo_fields(const HaloPlan& plan, const Communicator& comm, T*... fields) {
+  static_assert((std::is_trivially_copyable_v<T> && ...),
+                "a field sent to another rank must be trivially copyable");
   std::vector<std::vector<std::byte>> to_rank(plan.send.size());
   for (std::size_t r = 0; r < plan.send.size(); ++r)
-    for (const std::size_t k : plan.send[r]) migrate_detail::append(to_rank[r], field[k]);
+    for (const std::size_t k : plan.send[r]) (migrate_detail::append(to_rank[r], fields[k]), ...);
   std::vector<std::size_t> from;
   const std::vector<std::byte> in = comm.all_to_all(to_rank, from);
+  constexpr std::size_t bytes = (sizeof(T) + ...);
   std::size_t at = 0;
   for (std::size_t r = 0; r < plan.receive.size(); ++r) {
-    CELLSPH_CHECK(from[r] == plan.receive[r].size() * sizeof(T),
+    CELLSPH_CHECK(from[r] == plan.receive[r].size() * bytes,
                   "refresh_halo: " << from[r] << " bytes from rank " << r << " for " << plan.receive[r].size()
                                    << " copies");
-    for (const std::size_t k : plan.receive[r]) {
-      std::memcpy(&field[k], in.data() + at, sizeof(T));
-      at += sizeof(T);
-    }
+    for (const std::size_t k : plan.receive[r])
+      ((std::memcpy(&fields[k], in.data() + at, sizeof(T)), at += sizeof(T)), ...);
   }
+}
+
+// The same for one field.
+template <class T>
+void refresh_halo(std::vector<T>& field, const HaloPlan& plan, const Communicator& comm) {
+  refresh_halo_fields(plan, comm, field.data());
 }
 
 }  // namespace cellsph::distributed

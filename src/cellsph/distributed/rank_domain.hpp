@@ -3,7 +3,7 @@
 // copies of the other ranks' particles its rows need (the halo), and the collectives a step makes. The
 // Simulation holds one when the run spans several ranks and calls it at the start of each step (the
 // particles to their owners by the curve's cuts, the halo rebuilt), after each pass whose output a
-// neighbour reads (refresh), for the step size (min) and the stability check (first_bad, message), and
+// neighbour reads (refresh), for the step size (min) and the stability check (lowest, message), and
 // for the outputs (gather_to_root). A rank's arrays, owned and halo together, are in id order, so every
 // row runs in the single-process order and each owned particle gets the single-process bits.
 //
@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <span>
 #include <string>
@@ -59,8 +58,7 @@ class RankDomain {
       keys.push_back(grid_.key(p.x[i]));
       weights.push_back(static_cast<std::int64_t>(weight(i)));
     }
-    split_ = split_curve(keys, weights, Dim * grid_.bits, comm_.size(), kTolerance,
-                         [this](std::int64_t* v, int count) { comm_.sum_in_place(v, count); });
+    cut(keys, weights);
     std::vector<std::size_t> mine;
     for (std::size_t i = 0; i < n; ++i)
       if (split_.owner(grid_.key(p.x[i])) == comm_.rank()) mine.push_back(i);
@@ -79,8 +77,7 @@ class RankDomain {
       keys.push_back(grid_.key(p.x[i]));
       weights.push_back(static_cast<std::int64_t>(weight(i)));
     }
-    split_ = split_curve(keys, weights, Dim * grid_.bits, comm_.size(), kTolerance,
-                         [this](std::int64_t* v, int count) { comm_.sum_in_place(v, count); });
+    cut(keys, weights);
   }
 
   // Each step: the halo dropped, the owned particles sent to the ranks that own their keys now (the cuts
@@ -106,21 +103,7 @@ class RankDomain {
   // The same for arrays given by their first element (a view's arrays).
   template <class... T>
   void refresh(T*... fields) const {
-    const std::size_t ranks = plan_.send.size();
-    std::vector<std::vector<std::byte>> to_rank(ranks);
-    for (std::size_t r = 0; r < ranks; ++r)
-      for (const std::size_t k : plan_.send[r]) (migrate_detail::append(to_rank[r], fields[k]), ...);
-    std::vector<std::size_t> from;
-    const std::vector<std::byte> in = comm_.all_to_all(to_rank, from);
-    constexpr std::size_t bytes = (sizeof(T) + ...);
-    std::size_t at = 0;
-    for (std::size_t r = 0; r < plan_.receive.size(); ++r) {
-      CELLSPH_CHECK(from[r] == plan_.receive[r].size() * bytes,
-                    "refresh: " << from[r] << " bytes from rank " << r << " for " << plan_.receive[r].size()
-                                << " copies");
-      for (const std::size_t k : plan_.receive[r])
-        ((std::memcpy(&fields[k], in.data() + at, sizeof(T)), at += sizeof(T)), ...);
-    }
+    refresh_halo_fields(plan_, comm_, fields...);
   }
 
   // The smallest of every rank's value (a step size: each rank's is a monotone function of its maximum,
@@ -178,6 +161,12 @@ class RankDomain {
 
  private:
   static constexpr double kTolerance = 0.02;  // each rank's work within 2% of its share, where keys allow
+
+  // The cuts from this rank's share of the keys and weights (the histograms are summed over the ranks).
+  void cut(const std::vector<std::uint64_t>& keys, const std::vector<std::int64_t>& weights) {
+    split_ = split_curve(keys, weights, Dim * grid_.bits, comm_.size(), kTolerance,
+                         [this](std::int64_t* v, int count) { comm_.sum_in_place(v, count); });
+  }
 
   // p reduced to the particles `which` (ascending), every field.
   template <class Soa>

@@ -171,7 +171,7 @@ void Simulation<Dim, Real>::balance_domain() {
 template <int Dim, class Real>
 void Simulation<Dim, Real>::share_density() {
   if (!domain_) return;
-  domain_->refresh(p_.rho, p_.p, vol_, prho2_);  // (vectors: their arrays)
+  domain_->refresh(p_.rho, p_.p, vol_, prho2_);
 }
 
 template <int Dim, class Real>
